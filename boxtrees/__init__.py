@@ -1,0 +1,8 @@
+"""Box-test Extra-Trees: regression forests over variable-size sets of typed 2D objects."""
+from ._forest import BoxExtraTreesRegressor
+from ._grid import GridCounts
+from ._objects import ObjectSets
+from ._tree import BoxTree
+
+__all__ = ["BoxExtraTreesRegressor", "BoxTree", "GridCounts", "ObjectSets"]
+__version__ = "0.1.0"

@@ -1,0 +1,161 @@
+"""The grid representation of object sets: per-type object counts in the cells of a grid."""
+from numbers import Integral, Real
+
+import numpy as np
+from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
+from sklearn.utils._param_validation import Interval
+from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
+
+from ._objects import ObjectInputMixin, check_view_bounds
+
+__all__ = ["GridCounts"]
+
+
+class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
+    """Count the objects of each type in the cells of an ``n_bins x n_bins`` grid.
+
+    This is the fixed-size "grid" state representation of the thesis: the view is cut into
+    ``n_bins x n_bins`` equal cells and each sample becomes the ``n_bins * n_bins * n_types``
+    vector of per-cell, per-type counts, ordered as a C array of shape
+    ``(n_bins, n_bins, n_types)`` indexed ``[x cell, y cell, type]``. Objects outside the grid
+    and types not seen at fit are ignored.
+
+    A 2D feature matrix is read with column ``j`` as a one-dimensional object of type ``j``:
+    each column's range is cut into ``n_bins`` cells and the output is the
+    ``(n_bins, n_features)`` one-hot binning, flattened.
+
+    Parameters
+    ----------
+    n_bins : int, default=10
+        Number of cells along each axis.
+    view_bounds : array-like of 4 floats or float, default=None
+        Grid extent ``(xmin, xmax, ymin, ymax)``, or a half-width ``r`` for ``[-r, r]^2``.
+        None: the bounding box of the objects seen at fit (per column for a feature matrix).
+    n_types : int, default=None
+        Number of object types. None: one more than the largest type id seen at fit.
+
+    Attributes
+    ----------
+    n_types_ : int
+        Number of object types counted.
+    bounds_ : ndarray of shape (n_types_, 4)
+        Grid extent used for each type.
+    n_features_in_ : int
+        Number of columns, when fitted on a feature matrix.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from boxtrees import GridCounts
+    >>> sets = [np.array([[-5.0, -5.0, 0], [5.0, 5.0, 1]]), np.empty((0, 3))]
+    >>> GridCounts(n_bins=2, view_bounds=10).fit_transform(sets)
+    array([[1., 0., 0., 0., 0., 0., 0., 1.],
+           [0., 0., 0., 0., 0., 0., 0., 0.]])
+    """
+
+    _parameter_constraints = {
+        "n_bins": [Interval(Integral, 1, None, closed="left")],
+        "view_bounds": ["array-like", Interval(Real, 0, None, closed="neither"), None],
+        "n_types": [Interval(Integral, 1, None, closed="left"), None],
+    }
+
+    def __init__(self, n_bins=10, *, view_bounds=None, n_types=None):
+        self.n_bins = n_bins
+        self.view_bounds = view_bounds
+        self.n_types = n_types
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X, y=None):
+        """Learn the grid extent and the number of types.
+
+        Parameters
+        ----------
+        X : sequence of array-like of shape (n_i, 3), ObjectSets, or array of shape (n_samples, n_features)
+            Object sets, or a feature matrix.
+        y : None
+            Ignored.
+
+        Returns
+        -------
+        self : GridCounts
+        """
+        sets, _ = self._validate_input(X, reset=True)
+        data = sets.data
+        if self._fitted_on_features:
+            self.n_types_ = self.n_features_in_
+            if self.view_bounds is None:
+                x = data[:, 0].reshape(len(sets), -1)
+                self.bounds_ = np.column_stack([x.min(0), x.max(0), np.zeros((self.n_types_, 2))])
+            else:
+                self.bounds_ = np.tile(check_view_bounds(self.view_bounds), (self.n_types_, 1))
+            return self
+        if self.n_types is not None:
+            self.n_types_ = self.n_types
+        else:
+            self.n_types_ = int(data[:, 2].max()) + 1 if len(data) else 1
+        if self.view_bounds is not None:
+            bounds = check_view_bounds(self.view_bounds)
+        elif len(data):
+            bounds = np.array([data[:, 0].min(), data[:, 0].max(), data[:, 1].min(), data[:, 1].max()])
+        else:
+            raise ValueError("GridCounts needs view_bounds when X holds no object at all")
+        self.bounds_ = np.tile(bounds, (self.n_types_, 1))
+        return self
+
+    def _grid_shape(self):
+        """Cells along x and y (one along y for feature-matrix columns)."""
+        return self.n_bins, (1 if self._fitted_on_features else self.n_bins)
+
+    def transform(self, X):
+        """Count objects per cell and type.
+
+        Parameters
+        ----------
+        X : object sets or feature matrix, of the kind seen at fit
+
+        Returns
+        -------
+        counts : ndarray of shape (n_samples, n_bins * n_bins * n_types_)
+            (``n_bins * n_features`` for a feature matrix.)
+        """
+        check_is_fitted(self)
+        sets, _ = self._validate_input(X, reset=False)
+        nx, ny = self._grid_shape()
+        n_out = nx * ny * self.n_types_
+        data = sets.data
+        types = data[:, 2].astype(np.intp)
+        keep = types < self.n_types_
+        types, data, sample = types[keep], data[keep], sets.sample_index()[keep]
+        b = self.bounds_[types]
+        ix = _cell(data[:, 0], b[:, 0], b[:, 1], nx)
+        iy = _cell(data[:, 1], b[:, 2], b[:, 3], ny) if ny > 1 else np.zeros_like(ix)
+        inside = (ix >= 0) & (iy >= 0)
+        index = sample * n_out + (ix * ny + iy) * self.n_types_ + types
+        counts = np.bincount(index[inside], minlength=len(sets) * n_out)
+        return counts.reshape(len(sets), n_out).astype(np.float64)
+
+    def get_feature_names_out(self, input_features=None):
+        """Names of the output counts: ``"type{t}_x{i}_y{j}"`` (``"{feature}_bin{i}"`` for
+        a feature matrix).
+
+        Returns
+        -------
+        names : ndarray of str
+        """
+        check_is_fitted(self)
+        nx, ny = self._grid_shape()
+        if self._fitted_on_features:
+            features = _check_feature_names_in(self, input_features)
+            names = [f"{f}_bin{i}" for i in range(nx) for f in features]
+        else:
+            names = [f"type{t}_x{i}_y{j}" for i in range(nx) for j in range(ny) for t in range(self.n_types_)]
+        return np.asarray(names, dtype=object)
+
+
+def _cell(v, low, high, n_bins):
+    """Cell index of each value in ``n_bins`` equal cells of ``[low, high]``; -1 outside."""
+    width = high - low
+    scale = np.divide(n_bins, width, out=np.zeros_like(width), where=width > 0)
+    cell = np.floor((v - low) * scale).astype(np.intp)
+    cell = np.where(v == high, n_bins - 1, cell)
+    return np.where((v < low) | (v > high), -1, cell)

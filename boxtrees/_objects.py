@@ -1,0 +1,318 @@
+"""Ragged batches of 2D object sets, and the input checks shared by the estimators.
+
+An object is a row ``[x, y, type]``: a position and a non-negative integer type id. A sample is a
+set of objects (possibly empty). A batch of samples is stored as one ``(n_objects, 3)`` float32
+array plus offsets, so it is cheap to build, slice and hand to the Cython core.
+"""
+from numbers import Integral
+
+import numpy as np
+
+__all__ = ["ObjectSets"]
+
+_MAX_TYPE = 2**24  # float32 holds every integer type id below this exactly
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+def _offsets_from_sizes(sizes):
+    """Offsets ``[0, cumsum(sizes)...]`` of sets with the given sizes."""
+    offsets = np.zeros(len(sizes) + 1, dtype=np.intp)
+    np.cumsum(sizes, out=offsets[1:])
+    return offsets
+
+
+def _check_rows(data, what="object sets"):
+    """Validate object rows and return them as a C-contiguous float32 ``(n, 3)`` array."""
+    data = np.asarray(data)
+    if data.dtype == object or not (np.issubdtype(data.dtype, np.number) or data.dtype == bool):
+        raise TypeError(f"{what} must hold numbers, got an array of dtype {data.dtype}")
+    if np.iscomplexobj(data):
+        raise TypeError(f"{what} must hold real numbers, got complex values")
+    if data.size == 0:
+        return np.empty((0, 3), dtype=np.float32)
+    if data.ndim != 2 or data.shape[1] != 3:
+        raise ValueError(
+            f"{what} must be arrays of shape (n_objects, 3) with columns [x, y, type]; "
+            f"got shape {data.shape}"
+        )
+    if not np.isfinite(data).all():
+        raise ValueError(f"{what} contain NaN or infinite values")
+    if np.abs(data[:, :2]).max() > _FLOAT32_MAX:
+        raise ValueError(f"{what} have coordinates too large for float32 (|value| > 3.4e38)")
+    types = data[:, 2]
+    if types.min() < 0:
+        raise ValueError(f"{what} have negative type ids; type ids must be integers >= 0")
+    if not np.issubdtype(types.dtype, np.integer):
+        if (types != np.floor(types)).any():
+            raise ValueError(f"{what} have non-integer type ids; type ids must be integers >= 0")
+    if types.max() >= _MAX_TYPE:
+        raise ValueError(f"{what} have type ids >= {_MAX_TYPE}, which are not supported")
+    return np.ascontiguousarray(data, dtype=np.float32)
+
+
+class ObjectSets:
+    """A batch of object sets stored as one array of rows plus offsets.
+
+    Set ``i`` is ``data[offsets[i]:offsets[i + 1]]``. Building one validates its content once;
+    slicing and indexing return views or compact copies without re-validation.
+
+    Parameters
+    ----------
+    data : array-like of shape (n_objects, 3)
+        Rows ``[x, y, type]`` of all sets, set after set. Coordinates must be finite; types
+        non-negative integers.
+    offsets : array-like of int of shape (n_sets + 1,)
+        Non-decreasing, starting at 0 and ending at ``n_objects``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from boxtrees import ObjectSets
+    >>> sets = ObjectSets.from_sequence([np.array([[0.5, 1.0, 0]]), np.empty((0, 3))])
+    >>> len(sets), sets.sizes.tolist()
+    (2, [1, 0])
+    """
+
+    __slots__ = ("data", "offsets")
+
+    def __init__(self, data, offsets):
+        data = _check_rows(data)
+        offsets = np.asarray(offsets)
+        if offsets.ndim != 1 or offsets.size == 0 or not np.issubdtype(offsets.dtype, np.integer):
+            raise ValueError("offsets must be a non-empty 1D integer array")
+        if offsets[0] != 0 or offsets[-1] != len(data) or (np.diff(offsets) < 0).any():
+            raise ValueError(
+                f"offsets must be non-decreasing from 0 to n_objects={len(data)}; "
+                f"got {offsets[0]} ... {offsets[-1]}"
+            )
+        self.data = data
+        self.offsets = np.ascontiguousarray(offsets, dtype=np.intp)
+
+    @classmethod
+    def _trusted(cls, data, offsets):
+        """Wrap arrays that are already valid (internal: no checks, no copies)."""
+        self = cls.__new__(cls)
+        self.data, self.offsets = data, offsets
+        return self
+
+    @classmethod
+    def from_sequence(cls, sets):
+        """Build from a sequence of ``(n_i, 3)`` arrays (empty sets allowed).
+
+        Parameters
+        ----------
+        sets : sequence of array-like of shape (n_i, 3)
+
+        Returns
+        -------
+        ObjectSets
+        """
+        arrays = []
+        for i, s in enumerate(sets):
+            a = np.asarray(s)
+            if a.size == 0:
+                a = np.empty((0, 3), dtype=np.float32)
+            elif a.ndim != 2 or a.shape[1] != 3:
+                raise ValueError(
+                    f"each object set must have shape (n_objects, 3) with columns "
+                    f"[x, y, type]; set {i} has shape {a.shape}"
+                )
+            arrays.append(a)
+        sizes = np.fromiter((len(a) for a in arrays), dtype=np.intp, count=len(arrays))
+        data = np.concatenate(arrays) if arrays else np.empty((0, 3))
+        return cls._trusted(_check_rows(data), _offsets_from_sizes(sizes))
+
+    @classmethod
+    def from_features(cls, X):
+        """Read a 2D feature matrix as object sets: column ``j`` is one object of type ``j``.
+
+        The value is the object's x coordinate; y is 0.
+
+        Parameters
+        ----------
+        X : ndarray of shape (n_samples, n_features)
+            Finite values (already validated).
+        """
+        n_samples, n_features = X.shape
+        data = np.zeros((n_samples * n_features, 3), dtype=np.float32)
+        data[:, 0] = X.ravel()
+        data[:, 2] = np.tile(np.arange(n_features, dtype=np.float32), n_samples)
+        return cls._trusted(data, _offsets_from_sizes(np.full(n_samples, n_features)))
+
+    @classmethod
+    def concatenate(cls, batches):
+        """Join several batches into one, set order preserved."""
+        batches = list(batches)
+        if not batches:
+            return cls._trusted(np.empty((0, 3), dtype=np.float32), np.zeros(1, dtype=np.intp))
+        data = np.concatenate([b.data for b in batches])
+        return cls._trusted(data, _offsets_from_sizes(np.concatenate([b.sizes for b in batches])))
+
+    def __len__(self):
+        return len(self.offsets) - 1
+
+    @property
+    def sizes(self):
+        """Number of objects of each set, shape (n_sets,)."""
+        return np.diff(self.offsets)
+
+    @property
+    def n_objects(self):
+        """Total number of objects."""
+        return len(self.data)
+
+    def sample_index(self):
+        """The set each object row belongs to, shape (n_objects,)."""
+        return np.repeat(np.arange(len(self), dtype=np.intp), self.sizes)
+
+    def __getitem__(self, index):
+        """``sets[i]`` is the ``(n_i, 3)`` array of set ``i`` (a view); slices, integer arrays
+        and boolean masks give a new ``ObjectSets``."""
+        if isinstance(index, Integral):
+            n = len(self)
+            if not -n <= index < n:
+                raise IndexError(f"index {index} out of range for {n} object sets")
+            index %= n
+            return self.data[self.offsets[index] : self.offsets[index + 1]]
+        if isinstance(index, slice):
+            start, stop, step = index.indices(len(self))
+            if step == 1:
+                stop = max(start, stop)
+                offsets = self.offsets[start : stop + 1]
+                return ObjectSets._trusted(self.data[offsets[0] : offsets[-1]], offsets - offsets[0])
+            index = np.arange(start, stop, step)
+        index = np.asarray(index)
+        if index.dtype == bool:
+            if index.shape != (len(self),):
+                raise IndexError(f"boolean mask of shape {index.shape} for {len(self)} sets")
+            index = np.flatnonzero(index)
+        elif not np.issubdtype(index.dtype, np.integer) or index.ndim != 1:
+            raise IndexError("ObjectSets index must be an int, a slice, or a 1D int/bool array")
+        index = np.where(index < 0, index + len(self), index)
+        if index.size and (index.min() < 0 or index.max() >= len(self)):
+            raise IndexError(f"index out of range for {len(self)} object sets")
+        starts, sizes = self.offsets[index], self.sizes[index]
+        offsets = _offsets_from_sizes(sizes)
+        rows = np.repeat(starts - offsets[:-1], sizes) + np.arange(offsets[-1])
+        return ObjectSets._trusted(self.data[rows], offsets)
+
+    def __iter__(self):
+        for i in range(len(self)):
+            yield self.data[self.offsets[i] : self.offsets[i + 1]]
+
+    def __repr__(self):
+        return f"ObjectSets(n_sets={len(self)}, n_objects={self.n_objects})"
+
+    def __getstate__(self):
+        return {"data": self.data, "offsets": self.offsets}
+
+    def __setstate__(self, state):
+        self.data, self.offsets = state["data"], state["offsets"]
+
+
+def _is_ragged_batch(X):
+    """Duck-typed ObjectSets: ``data`` rows plus ``offsets`` (pandas frames excluded)."""
+    return hasattr(X, "offsets") and hasattr(X, "data") and not hasattr(X, "columns")
+
+
+def is_feature_matrix(X):
+    """Whether ``X`` is read as a 2D feature matrix rather than as object sets.
+
+    Object sets are an :class:`ObjectSets` (or any object with ``data`` and ``offsets``
+    arrays, such as the batched observations of ``envs``), a 3D array
+    ``(n_samples, n_objects, 3)``, or a sequence whose items are 2D arrays (or empty). Anything else (2D arrays, data frames,
+    sparse matrices, lists of rows, and invalid inputs) goes the feature-matrix way, where
+    scikit-learn's own validation reports what is wrong with it.
+    """
+    if isinstance(X, ObjectSets) or _is_ragged_batch(X):
+        return False
+    if isinstance(X, np.ndarray):
+        return not (X.ndim == 3 or (X.ndim == 1 and X.dtype == object))
+    if isinstance(X, (list, tuple)) and len(X) > 0:
+        first = X[0]
+        return not (np.ndim(first) == 2 or np.size(first) == 0)
+    return True
+
+
+def as_object_sets(X):
+    """Return object-set input ``X`` (see :func:`is_feature_matrix`) as validated ObjectSets."""
+    if isinstance(X, ObjectSets):
+        return X
+    if _is_ragged_batch(X):
+        return ObjectSets(X.data, X.offsets)
+    if isinstance(X, np.ndarray) and X.ndim == 3:
+        if X.shape[2] != 3:
+            raise ValueError(
+                f"a 3D array of object sets must have shape (n_samples, n_objects, 3); got {X.shape}"
+            )
+        data = _check_rows(X.reshape(-1, 3))
+        return ObjectSets._trusted(data, _offsets_from_sizes(np.full(X.shape[0], X.shape[1])))
+    return ObjectSets.from_sequence(X)
+
+
+def check_view_bounds(view_bounds):
+    """Validate ``view_bounds`` (``(xmin, xmax, ymin, ymax)`` or a half-width ``r`` for
+    ``[-r, r]^2``) and return it as a float array of 4."""
+    bounds = np.asarray(view_bounds, dtype=np.float64)
+    if bounds.ndim == 0:
+        bounds = np.array([-bounds, bounds, -bounds, bounds])
+    if bounds.shape != (4,) or not np.isfinite(bounds).all():
+        raise ValueError(
+            f"view_bounds must be (xmin, xmax, ymin, ymax) of finite numbers or a positive "
+            f"half-width; got {view_bounds!r}"
+        )
+    if bounds[0] >= bounds[1] or bounds[2] >= bounds[3]:
+        raise ValueError(f"view_bounds needs xmin < xmax and ymin < ymax; got {view_bounds!r}")
+    return bounds
+
+
+class ObjectInputMixin:
+    """Input handling shared by the estimators that accept object sets or a feature matrix.
+
+    A feature matrix goes through scikit-learn's ``validate_data`` (dtype, finiteness, feature
+    names, ``n_features_in_``) and is then read as object sets whose column ``j`` is a
+    one-dimensional object of type ``j``. The kind seen at fit is remembered, and predicting
+    or transforming with the other kind is an error.
+    """
+
+    def _validate_input(self, X, y=None, *, reset, requires_y=False):
+        from sklearn.utils.validation import check_array, column_or_1d, validate_data
+
+        dense = is_feature_matrix(X)
+        if not reset:
+            fitted_dense = self._fitted_on_features
+            if dense and not fitted_dense:
+                raise ValueError(
+                    f"{type(self).__name__} was fitted on object sets, but X is read as a 2D "
+                    f"feature matrix; pass a sequence of (n_i, 3) arrays or an ObjectSets "
+                    f"(a single object set must be wrapped in a list)"
+                )
+            if not dense and fitted_dense:
+                raise ValueError(
+                    f"{type(self).__name__} was fitted on a feature matrix with "
+                    f"{self.n_features_in_} features, but X holds object sets"
+                )
+        if dense:
+            if requires_y:
+                X, y = validate_data(self, X, y, reset=reset, dtype=np.float32, y_numeric=True)
+            else:
+                X = validate_data(self, X, reset=reset, dtype=np.float32)
+            sets = ObjectSets.from_features(X)
+        else:
+            sets = as_object_sets(X)
+            if reset:
+                for attr in ("n_features_in_", "feature_names_in_"):
+                    self.__dict__.pop(attr, None)
+            if requires_y:
+                if y is None:
+                    raise ValueError(f"{type(self).__name__} requires y to be passed, but the target y is None")
+                y = column_or_1d(check_array(y, ensure_2d=False, dtype=np.float64, input_name="y"), warn=True)
+        if reset:
+            if len(sets) == 0:
+                raise ValueError("X has no samples; at least one sample is required")
+            self._fitted_on_features = dense
+        if requires_y:
+            y = np.ascontiguousarray(y, dtype=np.float64)
+            if len(y) != len(sets):
+                raise ValueError(f"X has {len(sets)} samples but y has {len(y)}")
+        return sets, y

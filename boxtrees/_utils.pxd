@@ -1,0 +1,44 @@
+# Shared C-level types and the per-tree random number generator of the Cython core.
+from libc.stdint cimport int32_t, int64_t, uint8_t, uint64_t
+
+ctypedef float coord_t        # object coordinates and box bounds
+ctypedef double float64_t     # targets, weights, leaf values
+ctypedef int32_t int32
+ctypedef int64_t intp_t
+ctypedef uint8_t uint8
+ctypedef uint64_t uint64
+
+cdef enum:
+    TREE_LEAF = -1            # children_* of a leaf
+    TREE_UNDEFINED = -2       # object_type / threshold of a leaf
+
+cdef enum TestKind:
+    RANDOM = 0
+    FIXED = 1
+    BOUNDED = 2
+    CLASSIC = 3
+
+
+cdef inline uint64 rand_u64(uint64* state) noexcept nogil:
+    """Advance a splitmix64 state and return 64 random bits."""
+    cdef uint64 z
+    state[0] += <uint64>0x9E3779B97F4A7C15
+    z = state[0]
+    z = (z ^ (z >> 30)) * <uint64>0xBF58476D1CE4E5B9
+    z = (z ^ (z >> 27)) * <uint64>0x94D049BB133111EB
+    return z ^ (z >> 31)
+
+
+cdef inline double rand_unit(uint64* state) noexcept nogil:
+    """Uniform double in [0, 1)."""
+    return (rand_u64(state) >> 11) * (1.0 / 9007199254740992.0)
+
+
+cdef inline double rand_uniform(uint64* state, double low, double high) noexcept nogil:
+    """Uniform double in [low, high)."""
+    return low + (high - low) * rand_unit(state)
+
+
+cdef inline intp_t rand_int(uint64* state, intp_t n) noexcept nogil:
+    """Uniform integer in [0, n), n >= 1."""
+    return <intp_t>(rand_u64(state) % <uint64>n)
