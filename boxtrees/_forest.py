@@ -168,7 +168,10 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         sets, y = self._validate_input(X, y, reset=True, requires_y=True)
         if not np.isfinite(y).all():
             raise ValueError("y contains NaN or infinite values")
-        sample_weight = _check_sample_weight(sample_weight, sets, ensure_non_negative=True)
+        # ``sizes`` stands in for X: one entry per sample, a plain NumPy array
+        sample_weight = _check_sample_weight(
+            sample_weight, sets.sizes, dtype=np.float64, ensure_non_negative=True
+        )
         keep = sample_weight > 0
         if not keep.any():
             raise ValueError("sample_weight is zero for every sample; nothing to fit")
@@ -278,7 +281,7 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         return total / total.sum() if total.sum() > 0 else total
 
     def __getstate__(self):
-        state = super().__getstate__()
+        state = dict(super().__getstate__())  # a copy: object.__getstate__ returns __dict__ itself
         state.pop("_packed", None)
         return state
 

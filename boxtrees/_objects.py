@@ -7,6 +7,7 @@ array plus offsets, so it is cheap to build, slice and hand to the Cython core.
 from numbers import Integral
 
 import numpy as np
+from scipy.sparse import issparse
 
 __all__ = ["ObjectSets"]
 
@@ -211,8 +212,12 @@ class ObjectSets:
 
 
 def _is_ragged_batch(X):
-    """Duck-typed ObjectSets: ``data`` rows plus ``offsets`` (pandas frames excluded)."""
-    return hasattr(X, "offsets") and hasattr(X, "data") and not hasattr(X, "columns")
+    """Duck-typed ObjectSets: ``data`` rows plus ``offsets`` (not a data frame, not a sparse
+    DIA matrix, which has attributes of those names)."""
+    return (
+        hasattr(X, "offsets") and hasattr(X, "data")
+        and not hasattr(X, "columns") and not issparse(X)
+    )
 
 
 def is_feature_matrix(X):
