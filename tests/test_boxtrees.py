@@ -1,0 +1,197 @@
+"""Correctness of BoxExtraTreesRegressor on object sets: traversal, learning, determinism."""
+import pickle
+
+import joblib
+import numpy as np
+import pytest
+from sklearn.ensemble import ExtraTreesRegressor
+from sklearn.metrics import r2_score
+
+from boxtrees import BoxExtraTreesRegressor, GridCounts, ObjectSets, make_box_regression
+
+TEST_TYPES = ("fixed", "bounded", "random", "classic")
+
+
+def random_sets(rng, n, max_objects=10, n_types=4, extent=5.0):
+    """Ragged object sets with many empty ones."""
+    return [
+        np.column_stack([rng.uniform(-extent, extent, (k, 2)), rng.integers(0, n_types, k)])
+        for k in rng.integers(0, max_objects + 1, n)
+    ]
+
+
+def reference_leaf(tree, objects):
+    """Walk one tree in plain NumPy, reading only its exported node arrays."""
+    objects = np.asarray(objects, dtype=np.float32).reshape(-1, 3)
+    node = 0
+    while tree.children_left[node] != -1:
+        xmin, xmax, ymin, ymax = tree.box[node]
+        mine = objects[objects[:, 2] == tree.object_type[node]]
+        inside = (mine[:, 0] > xmin) & (mine[:, 0] < xmax) & (mine[:, 1] > ymin) & (mine[:, 1] < ymax)
+        go_left = inside.sum() < tree.threshold[node]
+        node = tree.children_left[node] if go_left else tree.children_right[node]
+    return node
+
+
+@pytest.mark.parametrize("test_type", TEST_TYPES)
+def test_predict_matches_numpy_reference_traversal(test_type):
+    rng = np.random.default_rng(0)
+    X, y = random_sets(rng, 400), rng.normal(size=400)
+    forest = BoxExtraTreesRegressor(
+        n_estimators=7, n_tests=20, min_samples_split=4, test_type=test_type,
+        test_width=1.5, random_state=0,
+    ).fit(X, y)
+    # unseen type 9 at predict time must match no test
+    X_new = random_sets(rng, 300, n_types=10) + [np.empty((0, 3))]
+    leaves = np.array([[reference_leaf(t, s) for t in forest.estimators_] for s in X_new])
+    expected = np.mean(
+        [[t.value[leaf] for t, leaf in zip(forest.estimators_, row)] for row in leaves], axis=1
+    )
+    np.testing.assert_array_equal(forest.apply(X_new), leaves)
+    np.testing.assert_allclose(forest.predict(X_new), expected, rtol=1e-12)
+    assert all(t.node_count > 20 for t in forest.estimators_)
+
+
+def test_node_arrays_are_consistent_with_training_data():
+    rng = np.random.default_rng(1)
+    X, y = random_sets(rng, 300), rng.normal(size=300)
+    forest = BoxExtraTreesRegressor(n_estimators=3, n_tests=30, min_samples_split=10, random_state=0)
+    forest.fit(X, y)
+    leaves = forest.apply(X)
+    for k, tree in enumerate(forest.estimators_):
+        inner = tree.children_left != -1
+        left, right = tree.children_left[inner], tree.children_right[inner]
+        np.testing.assert_array_equal(
+            tree.n_node_samples[inner], tree.n_node_samples[left] + tree.n_node_samples[right]
+        )
+        assert (tree.weighted_n_node_samples[inner] >= 10).all()
+        assert (tree.threshold[inner] >= 1).all() and (tree.threshold[~inner] == -2).all()
+        assert tree.n_node_samples[0] == len(X)
+        for leaf in np.unique(leaves[:, k]):
+            assert tree.children_left[leaf] == -1
+            np.testing.assert_allclose(tree.value[leaf], y[leaves[:, k] == leaf].mean())
+            assert tree.n_node_samples[leaf] == (leaves[:, k] == leaf).sum()
+
+
+@pytest.mark.parametrize("test_type, width", [("fixed", 1.0), ("bounded", 2.0), ("random", None), ("classic", None)])
+def test_box_shapes_follow_test_type(test_type, width):
+    rng = np.random.default_rng(2)
+    X, y = random_sets(rng, 300, extent=8.0), rng.normal(size=300)
+    bounds = (-8.0, 8.0, -6.0, 6.0)
+    forest = BoxExtraTreesRegressor(
+        n_estimators=3, n_tests=10, min_samples_split=5, test_type=test_type,
+        test_width=width or 1.0, view_bounds=bounds, random_state=0,
+    ).fit(X, y)
+    boxes = np.concatenate([t.box[t.children_left != -1] for t in forest.estimators_]).astype(float)
+    sizes = boxes[:, [1, 3]] - boxes[:, [0, 2]]
+    if test_type == "fixed":
+        np.testing.assert_allclose(sizes, 2 * width, atol=1e-5)
+    elif test_type == "bounded":
+        assert (sizes > 0).all() and (sizes <= 2 * width + 1e-5).all()
+        assert sizes.std() > 0.1
+    if test_type in ("fixed", "bounded"):
+        centres = (boxes[:, [0, 2]] + boxes[:, [1, 3]]) / 2
+        assert (centres[:, 0] >= bounds[0] - 1e-5).all() and (centres[:, 0] <= bounds[1] + 1e-5).all()
+        assert (centres[:, 1] >= bounds[2] - 1e-5).all() and (centres[:, 1] <= bounds[3] + 1e-5).all()
+    elif test_type == "random":
+        assert (boxes[:, 0] >= bounds[0]).all() and (boxes[:, 1] <= bounds[1]).all()
+        assert (boxes[:, 2] >= bounds[2]).all() and (boxes[:, 3] <= bounds[3]).all()
+    else:  # a half-plane: three infinite bounds, the upper bound of one axis finite
+        assert (np.isinf(boxes).sum(axis=1) == 3).all()
+        assert np.isneginf(boxes[:, [0, 2]]).all()
+        assert np.isfinite(boxes[:, 1]).any() and np.isfinite(boxes[:, 3]).any()
+
+
+def test_fixed_box_forest_learns_box_counts_better_than_grid_extra_trees():
+    X, y = make_box_regression(4000, random_state=0)
+    X_test, y_test = make_box_regression(2000, random_state=1)
+    forest = BoxExtraTreesRegressor(n_estimators=20, test_type="fixed", test_width=1.0,
+                                    n_jobs=2, random_state=0).fit(X, y)
+    ours = r2_score(y_test, forest.predict(X_test))
+    grid = GridCounts(10).fit(X)
+    et = ExtraTreesRegressor(n_estimators=20, min_samples_split=30, n_jobs=2, random_state=0)
+    theirs = r2_score(y_test, et.fit(grid.transform(X), y).predict(grid.transform(X_test)))
+    assert ours >= 0.85
+    assert ours > theirs
+    # the forest attends to coins and enemies (types 0 and 1), not to the distractors
+    importances = forest.feature_importances_
+    assert importances[:2].sum() > 0.8 and np.isclose(importances.sum(), 1.0)
+
+
+def test_same_seed_same_forest_whatever_n_jobs_and_after_pickling():
+    X, y = make_box_regression(600, random_state=0)
+    X_new, _ = make_box_regression(300, random_state=1)
+    params = dict(n_estimators=6, n_tests=50, min_samples_split=10, random_state=42)
+    serial = BoxExtraTreesRegressor(n_jobs=1, **params).fit(X, y)
+    threaded = BoxExtraTreesRegressor(n_jobs=2, **params).fit(X, y)
+    expected = serial.predict(X_new)
+    np.testing.assert_array_equal(threaded.predict(X_new), expected)
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(threaded)).predict(X_new), expected)
+    other = BoxExtraTreesRegressor(n_jobs=1, **{**params, "random_state": 43}).fit(X, y)
+    assert not np.array_equal(other.predict(X_new), expected)
+
+
+def test_parallel_predict_equals_serial_predict():
+    X, y = make_box_regression(500, random_state=0)
+    X_big, _ = make_box_regression(5000, random_state=1)
+    forest = BoxExtraTreesRegressor(n_estimators=4, n_tests=20, random_state=0).fit(X, y)
+    serial = forest.predict(X_big)
+    forest.set_params(n_jobs=2)
+    np.testing.assert_array_equal(forest.predict(X_big), serial)
+    np.testing.assert_array_equal(forest.apply(X_big), forest.set_params(n_jobs=1).apply(X_big))
+
+
+def test_dask_backend_builds_the_same_forest():
+    distributed = pytest.importorskip("dask.distributed")
+    X, y = make_box_regression(400, random_state=0)
+    params = dict(n_estimators=4, n_tests=30, min_samples_split=10, random_state=7)
+    expected = BoxExtraTreesRegressor(**params).fit(X, y).predict(X)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster):
+        with joblib.parallel_backend("dask"):
+            forest = BoxExtraTreesRegressor(n_jobs=-1, **params).fit(X, y)
+            got = forest.predict(X)
+    np.testing.assert_array_equal(got, expected)
+
+
+def test_input_forms_give_identical_forests():
+    rng = np.random.default_rng(3)
+    sets = random_sets(rng, 200)
+    y = rng.normal(size=200)
+    params = dict(n_estimators=3, n_tests=20, min_samples_split=5, random_state=0)
+    from_list = BoxExtraTreesRegressor(**params).fit(sets, y)
+    packed = ObjectSets.from_sequence(sets)
+    from_packed = BoxExtraTreesRegressor(**params).fit(packed, y)
+    np.testing.assert_array_equal(from_list.predict(packed), from_packed.predict(sets))
+    # a 3D array is a batch of equal-size sets
+    cube = rng.uniform(-5, 5, (50, 4, 3))
+    cube[:, :, 2] = rng.integers(0, 3, (50, 4))
+    np.testing.assert_array_equal(from_list.predict(cube), from_list.predict(list(cube)))
+
+
+def test_integer_weights_act_as_repeated_samples():
+    rng = np.random.default_rng(4)
+    sets = random_sets(rng, 150)
+    y = rng.normal(size=150)
+    weights = rng.integers(0, 4, 150)
+    params = dict(n_estimators=3, n_tests=20, min_samples_split=6, random_state=0)
+    weighted = BoxExtraTreesRegressor(**params).fit(sets, y, sample_weight=weights)
+    repeated = BoxExtraTreesRegressor(**params).fit(
+        [s for s, w in zip(sets, weights) for _ in range(w)], np.repeat(y, weights)
+    )
+    np.testing.assert_allclose(weighted.predict(sets), repeated.predict(sets), rtol=1e-10)
+
+
+def test_constant_target_and_objectless_data_give_single_leaf_trees():
+    forest = BoxExtraTreesRegressor(n_estimators=2).fit([np.empty((0, 3))] * 50, np.arange(50.0))
+    assert all(t.node_count == 1 for t in forest.estimators_)
+    np.testing.assert_allclose(forest.predict([np.array([[0.0, 0.0, 0]])]), 24.5)
+    rng = np.random.default_rng(5)
+    forest = BoxExtraTreesRegressor(n_estimators=2).fit(random_sets(rng, 60), np.full(60, 3.0))
+    assert all(t.node_count == 1 for t in forest.estimators_)
+
+
+def test_max_depth_limits_trees():
+    X, y = make_box_regression(500, random_state=0)
+    forest = BoxExtraTreesRegressor(n_estimators=3, max_depth=3, min_samples_split=2, random_state=0).fit(X, y)
+    assert max(t.max_depth for t in forest.estimators_) == 3
