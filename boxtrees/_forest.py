@@ -173,8 +173,6 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
             sample_weight, sets.sizes, dtype=np.float64, ensure_non_negative=True
         )
         keep = sample_weight > 0
-        if not keep.any():
-            raise ValueError("sample_weight is zero for every sample; nothing to fit")
         if not keep.all():
             sets, y, sample_weight = sets[keep], y[keep], sample_weight[keep]
 

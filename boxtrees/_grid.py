@@ -85,7 +85,9 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
             self.n_types_ = self.n_features_in_
             if self.view_bounds is None:
                 x = data[:, 0].reshape(len(sets), -1)
-                self.bounds_ = np.column_stack([x.min(0), x.max(0), np.zeros((self.n_types_, 2))])
+                self.bounds_ = np.column_stack(
+                    [x.min(0), x.max(0), np.zeros((self.n_types_, 2))]
+                ).astype(np.float64)
             else:
                 self.bounds_ = np.tile(check_view_bounds(self.view_bounds), (self.n_types_, 1))
             return self
@@ -96,7 +98,9 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         if self.view_bounds is not None:
             bounds = check_view_bounds(self.view_bounds)
         elif len(data):
-            bounds = np.array([data[:, 0].min(), data[:, 0].max(), data[:, 1].min(), data[:, 1].max()])
+            bounds = np.array(
+                [data[:, 0].min(), data[:, 0].max(), data[:, 1].min(), data[:, 1].max()], dtype=np.float64
+            )
         else:
             raise ValueError("GridCounts needs view_bounds when X holds no object at all")
         self.bounds_ = np.tile(bounds, (self.n_types_, 1))
@@ -156,6 +160,5 @@ def _cell(v, low, high, n_bins):
     """Cell index of each value in ``n_bins`` equal cells of ``[low, high]``; -1 outside."""
     width = high - low
     scale = np.divide(n_bins, width, out=np.zeros_like(width), where=width > 0)
-    cell = np.floor((v - low) * scale).astype(np.intp)
-    cell = np.where(v == high, n_bins - 1, cell)
+    cell = np.clip(np.floor((v - low) * scale), 0, n_bins - 1).astype(np.intp)
     return np.where((v < low) | (v > high), -1, cell)

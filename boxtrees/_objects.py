@@ -235,7 +235,7 @@ def is_feature_matrix(X):
         return not (X.ndim == 3 or (X.ndim == 1 and X.dtype == object))
     if isinstance(X, (list, tuple)) and len(X) > 0:
         first = X[0]
-        return not (np.ndim(first) == 2 or np.size(first) == 0)
+        return not (np.ndim(first) >= 2 or np.size(first) == 0)
     return True
 
 
@@ -308,13 +308,13 @@ class ObjectInputMixin:
             if reset:
                 for attr in ("n_features_in_", "feature_names_in_"):
                     self.__dict__.pop(attr, None)
+                if len(sets) == 0:
+                    raise ValueError("X has no samples; at least one sample is required")
             if requires_y:
                 if y is None:
                     raise ValueError(f"{type(self).__name__} requires y to be passed, but the target y is None")
                 y = column_or_1d(check_array(y, ensure_2d=False, dtype=np.float64, input_name="y"), warn=True)
         if reset:
-            if len(sets) == 0:
-                raise ValueError("X has no samples; at least one sample is required")
             self._fitted_on_features = dense
         if requires_y:
             y = np.ascontiguousarray(y, dtype=np.float64)
