@@ -1,0 +1,34 @@
+"""The ObjectWorld game of Blank (2015) as gymnasium environments, single and batched.
+
+Importing this package registers
+
+- ``ObjectWorld-v0``: four moves (up, right, down, left);
+- ``ObjectWorldSword-v0``: plus four sword swipes;
+- ``ObjectWorldTreasure-v0``: plus a 20-coin treasure stack near the border, observed
+  through ``view="local" | "global" | "minimap" | "arrow"``.
+
+Every rule constant is a keyword argument (see `WorldRules`), e.g.
+``gymnasium.make("ObjectWorldTreasure-v0", view="arrow", enemy_speed=0)``.
+"""
+from gymnasium.envs.registration import register
+
+from ._rules import (
+    ACTION_NAMES, ARROW, ENEMY, GRASS, MONEY, MONEY_MARKER, REFERENCE_SEED_START,
+    TREASURE_MARKER, TYPE_NAMES, VIEWS, WALL, WorldRules, reference_worlds,
+)
+from .batched import BatchedObjectWorld, RaggedBatch
+from .object_world import ObjectWorldEnv
+from .policies import GreedyPolicy
+from .wrappers import PaddedObjects, strip_padding
+
+__all__ = [
+    "ObjectWorldEnv", "BatchedObjectWorld", "RaggedBatch", "WorldRules", "PaddedObjects",
+    "strip_padding", "GreedyPolicy", "reference_worlds", "REFERENCE_SEED_START",
+    "MONEY", "WALL", "GRASS", "ENEMY", "MONEY_MARKER", "TREASURE_MARKER", "ARROW",
+    "TYPE_NAMES", "ACTION_NAMES", "VIEWS",
+]
+
+_ENTRY_POINT = "envs.object_world:ObjectWorldEnv"
+register(id="ObjectWorld-v0", entry_point=_ENTRY_POINT)
+register(id="ObjectWorldSword-v0", entry_point=_ENTRY_POINT, kwargs={"sword": True})
+register(id="ObjectWorldTreasure-v0", entry_point=_ENTRY_POINT, kwargs={"treasure": True})

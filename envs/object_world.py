@@ -1,0 +1,137 @@
+"""The ObjectWorld game as a gymnasium environment (one world)."""
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from ._engine import _Engine
+from ._render import render_local, render_world
+from ._rules import WorldRules
+
+__all__ = ["ObjectWorldEnv"]
+
+RENDER_VIEWS = ("world", "local")
+
+
+def _object_space(rules):
+    """``Sequence(Box, stack=True)`` of agent-relative objects ``[dx, dy, type]``."""
+    bound = rules.obs_bound
+    row = spaces.Box(low=np.array([-bound, -bound, 0], dtype=np.float32),
+                     high=np.array([bound, bound, rules.n_types - 1], dtype=np.float32),
+                     dtype=np.float32)
+    return spaces.Sequence(row, stack=True)
+
+
+def _check_action(action, n_actions):
+    """Return `action` as an int after checking it is a valid action id."""
+    if (isinstance(action, (bool, np.bool_))
+            or not spaces.Discrete(n_actions).contains(action)):
+        raise ValueError(
+            f"invalid action {action!r}: expected an int in [0, {n_actions}) "
+            f"(0 up, 1 right, 2 down, 3 left{', 4-7 swipes' if n_actions == 8 else ''})")
+    return int(action)
+
+
+class ObjectWorldEnv(gym.Env):
+    """The ObjectWorld game of Blank (2015): collect money, avoid enemies, don't hit walls.
+
+    The world is the square ``[-size_w, size_w]^2`` with a wall-lined border, filled at reset
+    with money (+100 when touched, then removed), walls (-50 when touched; they cancel the
+    move), grass (no effect) and enemies (-300 when touched, then removed). Enemies inside
+    the agent's view square chase it at `enemy_speed`. Each move goes 1 unit up, right, down
+    or left plus uniform noise on each coordinate. With ``sword=True`` four swipes hit the
+    ``swipe_size`` square next to the agent: exactly one enemy there: +300 and it dies; two
+    or more: -900; none: -750. With ``treasure=True`` a stack of coins lies near the border.
+
+    The rules run on the same vectorised engine as `BatchedObjectWorld`, here over one
+    world, so both give identical transitions for the same seeds and actions.
+
+    Parameters
+    ----------
+    render_mode : {None, "rgb_array"}, default=None
+    render_view : {"world", "local"}, default="world"
+        What `render` draws: the whole world with the agent's view square, or what the
+        agent observes.
+    **rules
+        The rule constants, see `WorldRules` for their meaning and defaults: `sword`,
+        `treasure`, `view`, `size_w`, `n_money`, `n_walls`, `n_grass`, `n_enemies`,
+        `enemy_speed`, `contact_radius`, `move_noise`, `swipe_size`, `view_size`,
+        `max_steps`, `n_treasure`, `treasure_radius`, `treasure_margin`, `start_clearance`.
+
+    Attributes
+    ----------
+    rules : WorldRules
+        The validated rule constants.
+    n_types : int
+        Type ids in observations lie in ``range(n_types)``.
+    view_size : float
+        Half-side of the view square.
+
+    Notes
+    -----
+    Observation: a float32 array of shape ``(n, 3)``, one row ``[dx, dy, type]`` per object
+    in view (see `WorldRules.view`), positions relative to the agent; space
+    ``Sequence(Box(3,), stack=True)``. Actions: ``Discrete(4)``, ``0`` up, ``1`` right,
+    ``2`` down, ``3`` left; ``Discrete(8)`` with the sword, ``4..7`` swiping in the same
+    directions. Reward: the sum of the step's contacts and swipe. Episodes never terminate;
+    they are truncated after `max_steps` steps. Each reset draws a new world from
+    ``self.np_random``.
+
+    Examples
+    --------
+    >>> import gymnasium as gym
+    >>> import envs
+    >>> env = gym.make("ObjectWorld-v0")
+    >>> obs, info = env.reset(seed=0)
+    >>> obs.shape[1], obs.dtype
+    (3, dtype('float32'))
+    >>> obs, reward, terminated, truncated, info = env.step(1)
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 8}
+
+    def __init__(self, render_mode=None, render_view="world", **rules):
+        self.rules = WorldRules(**rules)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"unknown render_mode {render_mode!r}; expected None or "
+                             f"one of {self.metadata['render_modes']}")
+        if render_view not in RENDER_VIEWS:
+            raise ValueError(f"unknown render_view {render_view!r}; expected one of "
+                             f"{RENDER_VIEWS}")
+        self.render_mode = render_mode
+        self.render_view = render_view
+        self.action_space = spaces.Discrete(self.rules.n_actions)
+        self.observation_space = _object_space(self.rules)
+        self._engine = _Engine(self.rules, 1)
+
+    @property
+    def n_types(self):
+        return self.rules.n_types
+
+    @property
+    def view_size(self):
+        return self.rules.view_size
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self._engine.reset([self.np_random])
+        return self._engine.observation[0], {}
+
+    def step(self, action):
+        action = _check_action(action, self.rules.n_actions)
+        if self._engine.observation is None:
+            raise RuntimeError("call reset() before step()")
+        if self._engine.t >= self.rules.max_steps:
+            raise RuntimeError(f"the episode was truncated after {self.rules.max_steps} steps; "
+                               "call reset()")
+        rewards, truncated = self._engine.step(np.array([action]))
+        return self._engine.observation[0], float(rewards[0]), False, truncated, {}
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without render_mode; pass render_mode='rgb_array'")
+            return None
+        if self._engine.observation is None:
+            raise RuntimeError("call reset() before render()")
+        if self.render_view == "local":
+            return render_local(self._engine.observation[0], self.rules)
+        return render_world(self._engine.world_objects(0), self._engine.agent[0], self.rules)

@@ -1,0 +1,85 @@
+"""A fixed-size observation for libraries that cannot take `Sequence` spaces."""
+from numbers import Integral
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+__all__ = ["PaddedObjects", "strip_padding"]
+
+
+class PaddedObjects(gym.ObservationWrapper):
+    """Pad the object set to a fixed ``(max_objects, 4)`` `Box` (e.g. for stable-baselines3).
+
+    Row ``j`` is ``[dx, dy, type, valid]``: the first ``n`` rows hold the observed objects
+    with ``valid = 1``, the remaining rows are zeros (``valid = 0``). `strip_padding` turns
+    padded observations back into object sets. When more than `max_objects` objects are in
+    view, the `max_objects` nearest to the agent are kept (in their original order).
+
+    Parameters
+    ----------
+    env : gymnasium.Env
+        An environment whose observation space is ``Sequence(Box(3,), stack=True)``, such as
+        `ObjectWorldEnv`.
+    max_objects : int
+        Number of rows of the padded observation.
+
+    Examples
+    --------
+    >>> import gymnasium as gym
+    >>> import envs
+    >>> env = envs.PaddedObjects(gym.make("ObjectWorld-v0"), max_objects=128)
+    >>> obs, _ = env.reset(seed=0)
+    >>> obs.shape, envs.strip_padding(obs)[0].shape[1]
+    ((128, 4), 3)
+    """
+
+    def __init__(self, env, max_objects):
+        super().__init__(env)
+        space = env.observation_space
+        if not (isinstance(space, spaces.Sequence) and space.stack
+                and isinstance(space.feature_space, spaces.Box)
+                and space.feature_space.shape == (3,)):
+            raise ValueError("PaddedObjects needs an observation space Sequence(Box(3,), "
+                             f"stack=True), got {space}")
+        if not isinstance(max_objects, Integral) or isinstance(max_objects, bool) \
+                or max_objects < 1:
+            raise ValueError(f"max_objects must be a positive int, got {max_objects!r}")
+        self.max_objects = int(max_objects)
+        row = space.feature_space
+        low = np.append(row.low, 0.0).astype(np.float32)
+        high = np.append(row.high, 1.0).astype(np.float32)
+        self.observation_space = spaces.Box(np.tile(low, (self.max_objects, 1)),
+                                            np.tile(high, (self.max_objects, 1)),
+                                            dtype=np.float32)
+
+    def observation(self, observation):
+        padded = np.zeros((self.max_objects, 4), dtype=np.float32)
+        if len(observation) > self.max_objects:
+            dist = np.hypot(observation[:, 0], observation[:, 1])
+            keep = np.sort(np.argpartition(dist, self.max_objects - 1)[:self.max_objects])
+            observation = observation[keep]
+        padded[:len(observation), :3] = observation
+        padded[:len(observation), 3] = 1.0
+        return padded
+
+
+def strip_padding(padded):
+    """Object sets from observations padded by `PaddedObjects`.
+
+    Parameters
+    ----------
+    padded : array-like of shape (max_objects, 4) or (batch, max_objects, 4)
+        Rows ``[dx, dy, type, valid]``.
+
+    Returns
+    -------
+    sets : list of ndarray of float32 of shape (n_i, 3)
+        The valid rows of each observation (a list of one for a single observation).
+    """
+    padded = np.asarray(padded, dtype=np.float32)
+    if padded.ndim not in (2, 3) or padded.shape[-1] != 4:
+        raise ValueError("padded observations must have shape (max_objects, 4) or "
+                         f"(batch, max_objects, 4) with a last 'valid' column; got {padded.shape}")
+    batch = padded[None] if padded.ndim == 2 else padded
+    return [rows[rows[:, 3] > 0.5, :3] for rows in batch]
