@@ -36,71 +36,41 @@ def _border_walls(size_w):
     ])
 
 
-def _draw_world(rules, rng):
-    """Draw one world from `rng`: random object positions, treasure coins and move noise.
-
-    Returns
-    -------
-    objects : ndarray of shape (n_money + n_walls + n_grass + n_enemies, 2)
-        Uniform in the world square, none within `start_clearance` of the centre.
-    coins : ndarray of shape (n_treasure or 0, 2)
-    centre : ndarray of shape (2,)
-        The treasure's centre (zeros without treasure).
-    noise : ndarray of shape (max_steps, 2)
-        The move noise of each step of the episode.
-    """
-    size_w = rules.size_w
+def _uniforms_per_world(rules):
+    """Number of uniform draws that lay out one world (see `_Engine.reset`)."""
     n_objects = rules.n_money + rules.n_walls + rules.n_grass + rules.n_enemies
-    objects = rng.uniform(-size_w, size_w, size=(n_objects, 2))
-    too_close = np.hypot(objects[:, 0], objects[:, 1]) < rules.start_clearance
-    while too_close.any():  # rejection keeps the density uniform outside the clearance
-        objects[too_close] = rng.uniform(-size_w, size_w, size=(int(too_close.sum()), 2))
-        too_close = np.hypot(objects[:, 0], objects[:, 1]) < rules.start_clearance
-    centre = np.zeros(2)
-    coins = np.empty((0, 2))
-    if rules.treasure:
-        side = rng.integers(4)
-        along = rng.uniform(-size_w + rules.treasure_margin, size_w - rules.treasure_margin)
-        centre = (size_w - rules.treasure_margin) * _DIRECTIONS[side]
-        centre[side % 2] = along  # x along the top and bottom sides, y along the others
-        radius, angle = rng.uniform(size=(2, rules.n_treasure))
-        radius = rules.treasure_radius * np.sqrt(radius)
-        angle = 2 * np.pi * angle
-        coins = centre + np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
-    noise = rng.uniform(-rules.move_noise, rules.move_noise, size=(rules.max_steps, 2))
-    return objects, coins, centre, noise
+    n_treasure = 2 + 2 * rules.n_treasure if rules.treasure else 0
+    return 2 * n_objects + n_treasure + 2 * rules.max_steps
 
 
-def _near_path(rel, seg, radius):
-    """Whether points `rel` lie within `radius` of the segment from 0 to `seg` (broadcasting)."""
-    rx, ry = rel[..., 0], rel[..., 1]
-    sx, sy = seg[..., 0], seg[..., 1]
+def _near_path(rx, ry, sx, sy, radius):
+    """Whether points ``(rx, ry)`` lie within `radius` of the segment from 0 to ``(sx, sy)``."""
     along = np.clip((rx * sx + ry * sy) / np.maximum(sx * sx + sy * sy, 1e-12), 0.0, 1.0)
     dx = rx - along * sx
     dy = ry - along * sy
     return dx * dx + dy * dy <= radius * radius
 
 
-def _ragged_concat(n_rows, parts):
+def _ragged_concat(n_worlds, parts):
     """Interleave ragged parts into one world-major ``(N, 3)`` float32 array plus offsets.
 
     Parameters
     ----------
-    n_rows : int
-        Number of worlds.
-    parts : list of (world, xy, types)
-        Rows of one kind: ``world`` their (non-decreasing) world ids, ``xy`` their
+    n_worlds : int
+    parts : list of (world, dx, dy, types)
+        Rows of one kind: ``world`` their non-decreasing world ids, ``dx, dy`` their
         agent-relative positions, ``types`` their type ids.
     """
-    counts = [np.bincount(world, minlength=n_rows) for world, _, _ in parts]
-    offsets = np.zeros(n_rows + 1, dtype=np.intp)
+    counts = [np.bincount(part[0], minlength=n_worlds) for part in parts]
+    offsets = np.zeros(n_worlds + 1, dtype=np.intp)
     np.cumsum(sum(counts), out=offsets[1:])
     data = np.empty((offsets[-1], 3), dtype=np.float32)
     base = offsets[:-1].copy()
-    for (world, xy, types), count in zip(parts, counts):
+    for (world, dx, dy, types), count in zip(parts, counts):
         first = np.cumsum(count) - count  # index of each world's first row inside this part
         dest = base[world] + (np.arange(len(world)) - first[world])
-        data[dest, :2] = xy
+        data[dest, 0] = dx
+        data[dest, 1] = dy
         data[dest, 2] = types
         base += count
     return data, offsets
@@ -129,62 +99,89 @@ class _Engine:
         self.rules = rules
         self.n_worlds = n_worlds
         size_w = rules.size_w
-        border = _border_walls(size_w)
-        self._border = border
+        self._border = _border_walls(size_w)
         n_coins = rules.n_treasure if rules.treasure else 0
+        self._n_random = rules.n_money + rules.n_walls + rules.n_grass
         self._static_types = np.repeat(
             np.array([WALL, MONEY, WALL, GRASS, MONEY], dtype=np.int8),
-            [len(border), rules.n_money, rules.n_walls, rules.n_grass, n_coins])
+            [len(self._border), rules.n_money, rules.n_walls, rules.n_grass, n_coins])
         self._n_static = len(self._static_types)
-        self._n_random_static = rules.n_money + rules.n_walls + rules.n_grass
-        # Grid of cells indexing the static objects, and the window of cells a step reads:
-        # everything touched by a path or seen from its end lies within `reach` of its start.
+        # A step reads the static objects in a window of grid cells around each agent:
+        # whatever its path touches or its view holds afterwards lies within `reach`.
         self._grid = math.ceil(2 * size_w / _GRID_CELL)
-        reach = max(rules.view_size, rules.contact_radius) + 1 + rules.move_noise
+        self._reach = max(rules.view_size, rules.contact_radius) + 1 + rules.move_noise
         if rules.view == "global":
-            reach = 4 * size_w
-        self._window = min(self._grid, math.ceil(2 * reach / _GRID_CELL) + 1)
-        self._reach = reach
-        # Minimap cells are view-sized.
-        self._minimap = math.ceil(size_w / rules.view_size)
+            self._reach = 4 * size_w
+        self._window = min(self._grid, math.ceil(2 * self._reach / _GRID_CELL) + 1)
+        # Only objects this close (per coordinate) to the agent can lie on its path.
+        self._path_reach = rules.contact_radius + 1 + rules.move_noise
+        self._minimap = math.ceil(size_w / rules.view_size)  # minimap cells are view-sized
         self.t = 0
         self.observation = None
 
     # ----------------------------------------------------------------------------------
     def reset(self, rngs):
-        """Draw every world afresh, world ``i`` from ``rngs[i]``."""
+        """Draw every world afresh, world ``i`` from ``rngs[i]``.
+
+        Each world takes one block of uniforms (object positions, treasure, the episode's
+        move noise), then redraws the objects that fell within `start_clearance` of the
+        centre (rejection keeps the density uniform outside it).
+        """
         rules, n = self.rules, self.n_worlds
-        draws = [_draw_world(rules, rng) for rng in rngs]
-        objects = np.stack([d[0] for d in draws])
-        n_rand = self._n_random_static
-        statics = np.concatenate([
-            np.broadcast_to(self._border, (n,) + self._border.shape),
-            objects[:, :n_rand],
-            np.stack([d[1] for d in draws]),
-        ], axis=1)
-        self._enemies = np.ascontiguousarray(objects[:, n_rand:])
-        self._enemy_alive = np.ones(self._enemies.shape[:2], dtype=bool)
-        self._treasure = np.stack([d[2] for d in draws])
-        self._noise = np.stack([d[3] for d in draws])
+        size_w = rules.size_w
+        n_uniforms = _uniforms_per_world(rules)
+        u = np.stack([rng.random(n_uniforms) for rng in rngs])
+        n_objects = self._n_random + rules.n_enemies
+        objects = (2 * size_w) * u[:, :2 * n_objects].reshape(n, n_objects, 2) - size_w
+        clearance2 = rules.start_clearance ** 2
+        near = (objects * objects).sum(axis=2) < clearance2
+        for i in np.flatnonzero(near.any(axis=1)):
+            while near[i].any():
+                objects[i, near[i]] = (2 * size_w) * rngs[i].random((near[i].sum(), 2)) - size_w
+                near[i] = (objects[i] * objects[i]).sum(axis=1) < clearance2
+        used = 2 * n_objects
+        coins = np.empty((n, 0, 2))
+        self._treasure = np.zeros((n, 2))
+        if rules.treasure:
+            side = (4 * u[:, used]).astype(np.intp)
+            inset = size_w - rules.treasure_margin
+            self._treasure = inset * _DIRECTIONS[side]
+            # x along the top and bottom sides, y along the others
+            self._treasure[np.arange(n), side % 2] = inset * (2 * u[:, used + 1] - 1)
+            radius, angle = u[:, used + 2:used + 2 + 2 * rules.n_treasure].reshape(n, 2, -1) \
+                .transpose(1, 0, 2)
+            radius = rules.treasure_radius * np.sqrt(radius)
+            angle = 2 * np.pi * angle
+            coins = self._treasure[:, None] + np.stack(
+                [radius * np.cos(angle), radius * np.sin(angle)], axis=2)
+            used += 2 + 2 * rules.n_treasure
+        self._noise = rules.move_noise * (2 * u[:, used:].reshape(n, rules.max_steps, 2) - 1)
+
+        self._ex = objects[:, self._n_random:, 0].copy()
+        self._ey = objects[:, self._n_random:, 1].copy()
+        self._enemy_alive = np.ones((n, rules.n_enemies), dtype=bool)
         self.agent = np.zeros((n, 2))
         self.t = 0
 
-        cells = self._cell_index(statics, _GRID_CELL, self._grid)
-        order = np.argsort(cells, axis=1, kind="stable")
-        cells = np.take_along_axis(cells, order, axis=1)
-        self._pos = np.take_along_axis(statics, order[..., None], axis=1).reshape(-1, 2)
+        # Static objects, sorted world by world and then by grid cell.
+        statics = np.concatenate([np.broadcast_to(self._border, (n,) + self._border.shape),
+                                  objects[:, :self._n_random], coins], axis=1)
+        cells = self._cell_index(statics[..., 0], statics[..., 1], _GRID_CELL, self._grid)
+        order = np.argsort(cells.astype(np.int16), axis=1, kind="stable")  # radix sort
         self._types = self._static_types[order].ravel()
+        order = (order + self._n_static * np.arange(n)[:, None]).ravel()
+        cells = cells.ravel()[order]
+        self._x = statics[..., 0].ravel()[order]
+        self._y = statics[..., 1].ravel()[order]
         self._alive = np.ones(len(self._types), dtype=bool)
+        # Flat start of every (world, cell), plus the end of the last one.
         n_cells = self._grid ** 2
-        counts = np.bincount((cells + n_cells * np.arange(n)[:, None]).ravel(),
-                             minlength=n * n_cells).reshape(n, n_cells)
-        self._cell_count = counts
-        self._cell_start = (np.cumsum(counts, axis=1) - counts
-                            + self._n_static * np.arange(n)[:, None])
+        self._cell_start = np.zeros(n * n_cells + 1, dtype=np.intp)
+        np.cumsum(np.bincount(cells + n_cells * (order // self._n_static),
+                              minlength=n * n_cells), out=self._cell_start[1:])
         if rules.view == "minimap":
             m = self._minimap
-            self._minimap_cell = self._cell_index(
-                self._pos.reshape(n, -1, 2), 2 * rules.view_size, m).ravel()
+            self._minimap_cell = self._cell_index(self._x, self._y, 2 * rules.view_size, m)
             world = np.repeat(np.arange(n), self._n_static)
             self._cell_money = np.bincount(
                 (world * m * m + self._minimap_cell)[self._types == MONEY],
@@ -208,18 +205,25 @@ class _Engine:
             Whether the episodes (all in lockstep) reached ``max_steps``.
         """
         rules, n = self.rules, self.n_worlds
+        radius = rules.contact_radius
         moves = actions < 4
         direction = _DIRECTIONS[actions & 3]
         delta = np.where(moves[:, None], direction + self._noise[:, self.t], 0.0)
-        old = self.agent
+        dx, dy = delta[:, 0], delta[:, 1]
+        ax, ay = self.agent[:, 0], self.agent[:, 1]
 
         # Static objects on the path: a wall cancels the move, otherwise money is collected.
         index, world = self._candidates()
-        types = self._types[index]
-        hit = _near_path(self._pos[index] - old[world], delta[world], rules.contact_radius)
-        hit &= moves[world]
-        blocked = np.bincount(world[hit & (types == WALL)], minlength=n) > 0
-        collected = hit & ~blocked[world] & (types == MONEY)
+        rx = self._x[index] - ax[world]
+        ry = self._y[index] - ay[world]
+        reach = self._path_reach
+        close = np.flatnonzero((np.abs(rx) <= reach) & (np.abs(ry) <= reach)
+                               & self._alive[index] & moves[world])
+        cw = world[close]
+        hit = close[_near_path(rx[close], ry[close], dx[cw], dy[cw], radius)]
+        types = self._types[index[hit]]
+        blocked = np.bincount(world[hit[types == WALL]], minlength=n) > 0
+        collected = hit[(types == MONEY) & ~blocked[world[hit]]]
         self._alive[index[collected]] = False
         rewards = _REWARD_WALL * blocked
         rewards += _REWARD_MONEY * np.bincount(world[collected], minlength=n)
@@ -231,26 +235,30 @@ class _Engine:
 
         # Enemies on the path, then the swipes.
         walked = moves & ~blocked
-        rel = self._enemies - old[:, None]
+        erx = self._ex - ax[:, None]
+        ery = self._ey - ay[:, None]
         touched = self._enemy_alive & walked[:, None]
-        touched &= _near_path(rel, delta[:, None], rules.contact_radius)
+        touched &= _near_path(erx, ery, dx[:, None], dy[:, None], radius)
         self._enemy_alive &= ~touched
-        rewards += _REWARD_ENEMY * touched.sum(axis=1)
+        rewards += _REWARD_ENEMY * np.count_nonzero(touched, axis=1)
         if rules.sword:
-            rewards += self._swipe(~moves, direction, rel)
-        self.agent = np.where(walked[:, None], old + delta, old)
+            rewards += self._swipe(~moves, direction, erx, ery)
+        self.agent = np.where(walked[:, None], self.agent + delta, self.agent)
+        ax, ay = self.agent[:, 0], self.agent[:, 1]
 
         # Enemies inside the view chase the agent; the ones that reach it hurt.
-        rel = self.agent[:, None] - self._enemies
-        dist = np.hypot(rel[..., 0], rel[..., 1])
-        chasing = self._enemy_alive & (np.abs(rel).max(axis=2) <= rules.view_size) & (dist > 0)
-        stride = np.divide(np.minimum(rules.enemy_speed, dist), dist,
-                           out=np.zeros_like(dist), where=chasing)
-        self._enemies += stride[..., None] * rel
-        rel = self.agent[:, None] - self._enemies
-        touched = self._enemy_alive & ((rel * rel).sum(axis=2) <= rules.contact_radius ** 2)
+        erx = ax[:, None] - self._ex
+        ery = ay[:, None] - self._ey
+        dist = np.sqrt(erx * erx + ery * ery)
+        view = rules.view_size
+        chasing = self._enemy_alive & (np.abs(erx) <= view) & (np.abs(ery) <= view)
+        stride = np.minimum(rules.enemy_speed, dist) / np.maximum(dist, 1e-12) * chasing
+        self._ex += stride * erx
+        self._ey += stride * ery
+        dist *= 1.0 - stride
+        touched = self._enemy_alive & (dist <= radius)
         self._enemy_alive &= ~touched
-        rewards += _REWARD_ENEMY * touched.sum(axis=1)
+        rewards += _REWARD_ENEMY * np.count_nonzero(touched, axis=1)
 
         if rules.view == "minimap":
             self._visit()
@@ -259,64 +267,73 @@ class _Engine:
         return rewards, self.t >= rules.max_steps
 
     # ----------------------------------------------------------------------------------
-    def _swipe(self, swiping, direction, rel):
+    def _swipe(self, swiping, direction, erx, ery):
         """Rewards of the swipes; a swipe that hits exactly one enemy kills it."""
         size = self.rules.swipe_size
         dx, dy = direction[:, None, 0], direction[:, None, 1]
-        along = rel[..., 0] * dx + rel[..., 1] * dy
-        across = rel[..., 0] * dy - rel[..., 1] * dx
+        along = erx * dx + ery * dy
+        across = erx * dy - ery * dx
         inside = self._enemy_alive & swiping[:, None]
         inside &= (along > 0) & (along <= size) & (np.abs(across) <= size / 2)
-        n_hit = inside.sum(axis=1)
+        n_hit = np.count_nonzero(inside, axis=1)
         self._enemy_alive &= ~(inside & (n_hit == 1)[:, None])
         rewards = np.select([n_hit == 0, n_hit == 1], [_REWARD_SWIPE_NONE, _REWARD_SWIPE_ONE],
                             _REWARD_SWIPE_MANY)
         return np.where(swiping, rewards, 0.0)
 
-    def _cell_index(self, pos, cell, n_cells):
+    def _cell_index(self, x, y, cell, n_cells):
         """Row-major index of the `cell`-sized grid cell holding each position."""
-        ij = np.clip(((pos + self.rules.size_w) // cell).astype(np.intp), 0, n_cells - 1)
-        return ij[..., 1] * n_cells + ij[..., 0]
+        size_w = self.rules.size_w
+        # Positions lie inside the world, so truncation is the floor.
+        i = np.minimum(((x + size_w) * (1 / cell)).astype(np.intp), n_cells - 1)
+        j = np.minimum(((y + size_w) * (1 / cell)).astype(np.intp), n_cells - 1)
+        return j * n_cells + i
 
     def _candidates(self):
-        """Live static objects in the window of cells around each agent.
+        """Static objects (dead ones too) in the window of cells around each agent.
+
+        The window is `_window` cells high and wide; its cells in one grid row are
+        consecutive in the sorted order, so the window is one slice per row.
 
         Returns their flat indices and world ids, world after world.
         """
         g, w = self._grid, self._window
         corner = (self.agent - self._reach + self.rules.size_w) // _GRID_CELL
         corner = np.clip(corner.astype(np.intp), 0, g - w)
-        offsets = np.arange(w)
-        cells = ((corner[:, 1, None, None] + offsets[:, None]) * g
-                 + corner[:, 0, None, None] + offsets).reshape(self.n_worlds, -1)
-        count = np.take_along_axis(self._cell_count, cells, axis=1).ravel()
-        start = np.take_along_axis(self._cell_start, cells, axis=1).ravel()
+        first_cell = ((corner[:, 1, None] + np.arange(w)) * g + corner[:, 0, None]
+                      + (g * g) * np.arange(self.n_worlds)[:, None]).ravel()
+        first = self._cell_start[first_cell]
+        count = self._cell_start[first_cell + w] - first
         end = np.cumsum(count)
-        index = np.repeat(start - (end - count), count) + np.arange(end[-1])
-        index = index[self._alive[index]]
+        index = np.repeat(first - (end - count), count) + np.arange(end[-1])
         return index, index // self._n_static
 
     def _observe(self, index, world):
-        """The agents' observations, given live static candidates `index` of `world`."""
+        """The agents' observations, given the static candidates `index` of `world`."""
         rules = self.rules
-        rel = self._pos[index] - self.agent[world]
-        erel = self._enemies - self.agent[:, None]
+        ax, ay = self.agent[:, 0], self.agent[:, 1]
+        rx = self._x[index] - ax[world]
+        ry = self._y[index] - ay[world]
+        erx = self._ex - ax[:, None]
+        ery = self._ey - ay[:, None]
         seen = self._alive[index]
-        enemy_seen = self._enemy_alive.copy()
+        enemy_seen = self._enemy_alive
         if rules.view != "global":
-            seen &= np.abs(rel).max(axis=1) <= rules.view_size
-            enemy_seen &= np.abs(erel).max(axis=2) <= rules.view_size
+            view = rules.view_size
+            seen &= (np.abs(rx) <= view) & (np.abs(ry) <= view)
+            enemy_seen = enemy_seen & (np.abs(erx) <= view) & (np.abs(ery) <= view)
         enemy_world, enemy = np.nonzero(enemy_seen)
+        seen = np.flatnonzero(seen)
         parts = [
-            (world[seen], rel[seen], self._types[index[seen]]),
-            (enemy_world, erel[enemy_world, enemy], ENEMY),
+            (world[seen], rx[seen], ry[seen], self._types[index[seen]]),
+            (enemy_world, erx[enemy_world, enemy], ery[enemy_world, enemy], ENEMY),
         ]
         if rules.view in ("minimap", "arrow"):
             marker_world, xy, types = self._markers()
             xy -= self.agent[marker_world]
             if rules.view == "minimap":  # the whole world shrunk into the view
                 xy *= rules.view_size / (2 * rules.size_w)
-            parts.append((marker_world, xy, types))
+            parts.append((marker_world, xy[:, 0], xy[:, 1], types))
         return _ragged_concat(self.n_worlds, parts)
 
     def _markers(self):
@@ -324,8 +341,8 @@ class _Engine:
 
         Minimap: a `MONEY_MARKER` at the centre of each unvisited cell holding money, then a
         `TREASURE_MARKER` at the centre of the treasure's cell until it is visited (centres of
-        the cells' parts inside the world). Arrow:
-        one `ARROW` at ``0.9 * view_size`` from the agent toward the treasure's centre.
+        the cells' parts inside the world). Arrow: one `ARROW` at ``0.9 * view_size`` from
+        the agent toward the treasure's centre.
         """
         rules = self.rules
         if rules.view == "arrow":
@@ -335,7 +352,8 @@ class _Engine:
                               out=np.zeros_like(to_goal), where=dist > 0)
             return np.arange(self.n_worlds), self.agent + arrow, ARROW
         m = self._minimap
-        goal_cell = self._cell_index(self._treasure, 2 * rules.view_size, m)
+        goal_cell = self._cell_index(self._treasure[:, 0], self._treasure[:, 1],
+                                     2 * rules.view_size, m)
         shown = np.column_stack([
             (self._cell_money > 0) & ~self._visited,
             ~np.take_along_axis(self._visited, goal_cell[:, None], axis=1),
@@ -351,7 +369,8 @@ class _Engine:
 
     def _visit(self):
         """Mark the minimap cells holding the agents as visited."""
-        cell = self._cell_index(self.agent, 2 * self.rules.view_size, self._minimap)
+        cell = self._cell_index(self.agent[:, 0], self.agent[:, 1],
+                                2 * self.rules.view_size, self._minimap)
         self._visited[np.arange(self.n_worlds), cell] = True
 
     def world_objects(self, i):
@@ -359,12 +378,13 @@ class _Engine:
 
         The live objects, then the markers of the treasure views.
         """
-        n_static = self._n_static
-        own = slice(i * n_static, (i + 1) * n_static)
+        own = slice(i * self._n_static, (i + 1) * self._n_static)
         alive = self._alive[own]
-        rows = [np.column_stack([self._pos[own][alive], self._types[own][alive]]),
-                np.column_stack([self._enemies[i][self._enemy_alive[i]],
-                                 np.full(self._enemy_alive[i].sum(), ENEMY)])]
+        enemies = self._enemy_alive[i]
+        rows = [np.column_stack([self._x[own][alive], self._y[own][alive],
+                                 self._types[own][alive]]),
+                np.column_stack([self._ex[i, enemies], self._ey[i, enemies],
+                                 np.full(enemies.sum(), ENEMY)])]
         if self.rules.view in ("minimap", "arrow"):
             world, xy, types = self._markers()
             mine = world == i

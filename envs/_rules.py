@@ -105,9 +105,9 @@ class WorldRules:
     size_w : float, default=30.0
         The world is the square ``[-size_w, size_w]^2``, its border lined with walls at most
         1 unit apart; the agent starts at the centre.
-    n_money, n_walls, n_grass, n_enemies : int, defaults 30, 30, 30, 30
+    n_money, n_walls, n_grass, n_enemies : int, defaults 40, 30, 30, 13
         Numbers of objects spawned uniformly in the world (walls besides the border).
-    enemy_speed : float, default=0.4
+    enemy_speed : float, default=0.2
         Distance per step that an enemy inside the agent's view square moves toward the
         agent (the agent moves 1). 0 gives static enemies.
     contact_radius : float, default=0.6
@@ -147,11 +147,11 @@ class WorldRules:
     treasure: bool = False
     view: str = "local"
     size_w: float = 30.0
-    n_money: int = 30
+    n_money: int = 40
     n_walls: int = 30
     n_grass: int = 30
-    n_enemies: int = 30
-    enemy_speed: float = 0.4
+    n_enemies: int = 13
+    enemy_speed: float = 0.2
     contact_radius: float = 0.6
     move_noise: float = 0.1
     swipe_size: float = 3.0
