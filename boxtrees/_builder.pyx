@@ -1,14 +1,18 @@
 """Growing one box-test tree (the hot loop of ``BoxExtraTreesRegressor.fit``).
 
-The training objects are kept per type, sorted by x, in contiguous buffers. Each node owns, for
-every type, one contiguous range of those buffers. A box test binary-searches the x strip of its
-box inside the range of its type and checks y only there, so its cost is the number of objects in
-the strip, not in the node. Only samples hit by the box get a non-zero count, which is all the
-threshold draw and the score need. Splitting a node partitions every range stably, so both
-children keep their objects sorted by x. Nodes are grown depth first from an explicit stack:
-fixed 2 x 2 boxes make trees hundreds of levels deep.
+The training objects are kept in contiguous *segments*, one per (type, y band): the y axis is
+cut into a few bands and the objects of a segment are sorted by x. Each node owns one
+contiguous range of every segment. A box test visits the bands its y extent overlaps and
+binary-searches the x strip of its box in each, so its cost is the number of objects in that
+narrow strip, not in the node; bands lying wholly inside the box need no y comparison at all.
+Only samples hit by the box get a non-zero count, which is all the threshold draw and the score
+need. Splitting a node partitions every segment range stably, so both children keep their
+objects sorted by x. Nodes are grown depth first from an explicit stack: fixed 2 x 2 boxes make
+trees hundreds of levels deep.
 """
 import numpy as np
+
+cimport numpy as cnp
 
 from libc.math cimport INFINITY
 from libc.limits cimport INT_MAX
@@ -19,11 +23,6 @@ from ._utils cimport (
     coord_t, float64_t, int32, intp_t, uint8, uint64,
     rand_int, rand_uniform, rand_unit,
 )
-
-cdef enum:
-    # The y test of a strip runs in chunks: one branch-free, vectorisable pass writes the
-    # inside flags, a second pass scatters the counts.
-    CHUNK = 256
 
 TEST_KINDS = {"random": RANDOM, "fixed": FIXED, "bounded": BOUNDED, "classic": CLASSIC}
 
@@ -58,52 +57,70 @@ cdef struct StackRecord:
     bint is_left
 
 
+# Branch-free binary searches (the comparison compiles to a conditional move): the positions
+# searched are random, so a branchy search would mispredict half of its steps.
+
 cdef inline intp_t _first_above(const coord_t* x, intp_t lo, intp_t hi, coord_t v) noexcept nogil:
     """First index in [lo, hi) of sorted ``x`` with x > v (hi if none)."""
-    cdef intp_t mid
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if x[mid] > v:
-            hi = mid
-        else:
-            lo = mid + 1
-    return lo
+    cdef const coord_t* base = x + lo
+    cdef intp_t n = hi - lo, half
+    if n == 0:
+        return lo
+    while n > 1:
+        half = n >> 1
+        base = base + half if base[half] <= v else base
+        n -= half
+    return (base - x) + (base[0] <= v)
 
 
 cdef inline intp_t _first_not_below(const coord_t* x, intp_t lo, intp_t hi, coord_t v) noexcept nogil:
     """First index in [lo, hi) of sorted ``x`` with x >= v (hi if none)."""
-    cdef intp_t mid
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if x[mid] >= v:
-            hi = mid
-        else:
-            lo = mid + 1
-    return lo
+    cdef const coord_t* base = x + lo
+    cdef intp_t n = hi - lo, half
+    if n == 0:
+        return lo
+    while n > 1:
+        half = n >> 1
+        base = base + half if base[half] < v else base
+        n -= half
+    return (base - x) + (base[0] < v)
+
+
+cnp.import_array()
+
+
+cdef inline void* _data(cnp.ndarray a) noexcept:
+    return cnp.PyArray_DATA(a)
 
 
 cdef class _Splitter:
     """Draws, scores and applies the box tests of the node being split.
 
-    Holds the tree's own copy of the per-type object buffers (it partitions them) and the
-    per-sample scratch arrays. ``lo[t]:hi[t]`` is the current node's range of type ``t``.
+    Holds the tree's own copy of the segment buffers (it partitions them) and the per-sample
+    scratch arrays. Segment ``g = type * n_bands + band`` of the current node is
+    ``lo[g]:hi[g]``.
     """
-    cdef coord_t[::1] xs
-    cdef coord_t[::1] ys
-    cdef int32[::1] sid
-    cdef coord_t[::1] tmp_x
-    cdef coord_t[::1] tmp_y
-    cdef int32[::1] tmp_sid
-    cdef int32[::1] samples
-    cdef int32[::1] counts
-    cdef int32[::1] hits
-    cdef uint8[::1] goes_right
-    cdef intp_t[::1] lo
-    cdef intp_t[::1] hi
-    cdef const float64_t[::1] target
-    cdef const float64_t[::1] weight
+    cdef list _keep_alive            # the NumPy arrays behind the pointers below
+    cdef coord_t* xs
+    cdef coord_t* ys
+    cdef int32* sid
+    cdef coord_t* tmp_x
+    cdef coord_t* tmp_y
+    cdef int32* tmp_sid
+    cdef int32* strip                # sample ids of the objects of a strip inside the box
+    cdef int32* samples
+    cdef int32* counts
+    cdef int32* hits
+    cdef uint8* goes_right
+    cdef intp_t* lo
+    cdef intp_t* hi
+    cdef const float64_t* target
+    cdef const float64_t* weight
+    cdef const float64_t* edges      # band edges, n_bands + 1, from -inf to +inf
     cdef const coord_t[:, ::1] bounds
+    cdef intp_t n_samples
     cdef intp_t n_types
+    cdef intp_t n_bands
     cdef int kind
     cdef double width
     cdef bint local_x
@@ -116,27 +133,44 @@ cdef class _Splitter:
     cdef double w_sum
     cdef double wy_sum
 
-    def __cinit__(self, const coord_t[::1] x, const coord_t[::1] y, const int32[::1] sample_of,
-                  const float64_t[::1] target, const float64_t[::1] weight,
+    def __cinit__(self, x, y, sample_of, target, weight, band_edges,
                   const coord_t[:, ::1] bounds, bint local_x, int kind, double width,
                   intp_t n_tests, intp_t max_retries, uint64 seed):
-        cdef intp_t n_objects = x.shape[0], n_samples = target.shape[0]
-        self.xs = np.array(x, dtype=np.float32)
-        self.ys = np.array(y, dtype=np.float32)
-        self.sid = np.array(sample_of, dtype=np.int32)
-        self.tmp_x = np.empty(n_objects, dtype=np.float32)
-        self.tmp_y = np.empty(n_objects, dtype=np.float32)
-        self.tmp_sid = np.empty(n_objects, dtype=np.int32)
-        self.samples = np.arange(n_samples, dtype=np.int32)
-        self.counts = np.zeros(n_samples, dtype=np.int32)
-        self.hits = np.empty(n_samples, dtype=np.int32)
-        self.goes_right = np.zeros(n_samples, dtype=np.uint8)
-        self.n_types = bounds.shape[0]
-        self.lo = np.empty(self.n_types, dtype=np.intp)
-        self.hi = np.empty(self.n_types, dtype=np.intp)
-        self.target = target
-        self.weight = weight
+        cdef intp_t n_objects = max(len(x), 1), n_samples = len(target)
+        cdef intp_t n_segments = bounds.shape[0] * (len(band_edges) - 1)
+        arrays = [
+            np.array(x, dtype=np.float32), np.array(y, dtype=np.float32),
+            np.array(sample_of, dtype=np.int32),
+            np.empty(n_objects, dtype=np.float32), np.empty(n_objects, dtype=np.float32),
+            np.empty(n_objects, dtype=np.int32), np.empty(n_objects, dtype=np.int32),
+            np.arange(n_samples, dtype=np.int32), np.zeros(n_samples, dtype=np.int32),
+            np.empty(n_samples, dtype=np.int32), np.zeros(n_samples, dtype=np.uint8),
+            np.empty(n_segments, dtype=np.intp), np.empty(n_segments, dtype=np.intp),
+            np.ascontiguousarray(target, dtype=np.float64),
+            np.ascontiguousarray(weight, dtype=np.float64),
+            np.ascontiguousarray(band_edges, dtype=np.float64),
+        ]
+        self._keep_alive = arrays
+        self.xs = <coord_t*>_data(arrays[0])
+        self.ys = <coord_t*>_data(arrays[1])
+        self.sid = <int32*>_data(arrays[2])
+        self.tmp_x = <coord_t*>_data(arrays[3])
+        self.tmp_y = <coord_t*>_data(arrays[4])
+        self.tmp_sid = <int32*>_data(arrays[5])
+        self.strip = <int32*>_data(arrays[6])
+        self.samples = <int32*>_data(arrays[7])
+        self.counts = <int32*>_data(arrays[8])
+        self.hits = <int32*>_data(arrays[9])
+        self.goes_right = <uint8*>_data(arrays[10])
+        self.lo = <intp_t*>_data(arrays[11])
+        self.hi = <intp_t*>_data(arrays[12])
+        self.target = <const float64_t*>_data(arrays[13])
+        self.weight = <const float64_t*>_data(arrays[14])
+        self.edges = <const float64_t*>_data(arrays[15])
         self.bounds = bounds
+        self.n_samples = n_samples
+        self.n_types = bounds.shape[0]
+        self.n_bands = len(band_edges) - 1
         self.local_x = local_x
         self.kind = kind
         self.width = width
@@ -151,12 +185,18 @@ cdef class _Splitter:
         cdef double y0 = self.bounds[ty, 2], y1 = self.bounds[ty, 3]
         cdef bint one_dim = y0 == -INFINITY     # feature-matrix columns: the y extent is unbounded
         cdef double a, b, h
+        cdef intp_t g, n_objects = 0
         t.object_type = ty
-        if self.lo[ty] == self.hi[ty]:
+        for g in range(ty * self.n_bands, (ty + 1) * self.n_bands):
+            n_objects += self.hi[g] - self.lo[g]
+        if n_objects == 0:
             return False
         if self.local_x:
-            x0 = self.xs[self.lo[ty]]
-            x1 = self.xs[self.hi[ty] - 1]
+            x0, x1 = INFINITY, -INFINITY
+            for g in range(ty * self.n_bands, (ty + 1) * self.n_bands):
+                if self.hi[g] > self.lo[g]:
+                    x0 = min(x0, self.xs[self.lo[g]])
+                    x1 = max(x1, self.xs[self.hi[g] - 1])
         t.ymin = -INFINITY
         t.ymax = INFINITY
         if self.kind == RANDOM:
@@ -193,40 +233,51 @@ cdef class _Splitter:
         Returns the number of samples hit; their ids are ``hits[:n]`` and their counts sit in
         ``counts`` (the caller resets them).
         """
-        cdef const coord_t* xs = &self.xs[0]
-        cdef const coord_t* ys = &self.ys[0]
-        cdef const int32* sid = &self.sid[0]
-        cdef int32* counts = &self.counts[0]
-        cdef int32* hits = &self.hits[0]
-        cdef intp_t a = _first_above(xs, self.lo[t.object_type], self.hi[t.object_type], t.xmin)
-        cdef intp_t b = _first_not_below(xs, a, self.hi[t.object_type], t.xmax)
+        cdef const coord_t* xs = self.xs
+        cdef const coord_t* ys = self.ys
+        cdef const int32* sid = self.sid
+        cdef const int32* inside
+        cdef int32* strip = self.strip
+        cdef int32* counts = self.counts
+        cdef int32* hits = self.hits
+        cdef const float64_t* edges = self.edges
         cdef coord_t ymin = t.ymin, ymax = t.ymax
-        cdef intp_t j, n, n_hit = 0
+        cdef intp_t band, g, a, e, j, n, n_hit = 0
         cdef int32 s
-        cdef uint8 inside[CHUNK]
-        while a < b:
-            n = min(<intp_t>CHUNK, b - a)
+        for band in range(self.n_bands):
+            if edges[band + 1] <= ymin or edges[band] >= ymax:
+                continue
+            g = t.object_type * self.n_bands + band
+            a = _first_above(xs, self.lo[g], self.hi[g], t.xmin)
+            e = _first_not_below(xs, a, self.hi[g], t.xmax)
+            if ((ymin < edges[band] or ymin == -INFINITY)
+                    and (edges[band + 1] <= ymax or ymax == INFINITY)):
+                inside = sid + a                # the band lies within the box's y extent
+                n = e - a
+            else:
+                n = 0                           # branch-free compaction of the y test
+                for j in range(a, e):
+                    strip[n] = sid[j]
+                    n += (ys[j] > ymin) & (ys[j] < ymax)
+                inside = strip
             for j in range(n):
-                inside[j] = (ys[a + j] > ymin) & (ys[a + j] < ymax)
-            for j in range(n):
-                if inside[j]:
-                    s = sid[a + j]
-                    if counts[s] == 0:
-                        hits[n_hit] = s
-                        n_hit += 1
-                    counts[s] += 1
-            a += n
+                s = inside[j]
+                hits[n_hit] = s
+                n_hit += counts[s] == 0
+                counts[s] += 1
         return n_hit
 
     cdef bint evaluate(self, BoxTest* t) noexcept nogil:
         """Draw the threshold of a test and score it; False if its counts are constant."""
         cdef intp_t n_hit = self.count(t)
+        cdef int32* counts = self.counts
+        cdef const int32* hits = self.hits
         cdef intp_t j
         cdef int32 s, c, cmin = INT_MAX, cmax = 0
         cdef double wr = 0.0, wyr = 0.0, wl, wyl
         cdef bint valid
         for j in range(n_hit):
-            c = self.counts[self.hits[j]]
+            c = counts[hits[j]]
             cmin = min(cmin, c)
             cmax = max(cmax, c)
         if n_hit < self.end - self.start:
@@ -235,8 +286,8 @@ cdef class _Splitter:
         if valid:
             t.threshold = cmin + 1 + <int32>rand_int(&self.rng, cmax - cmin)
             for j in range(n_hit):
-                s = self.hits[j]
-                if self.counts[s] >= t.threshold:
+                s = hits[j]
+                if counts[s] >= t.threshold:
                     wr += self.weight[s]
                     wyr += self.weight[s] * self.target[s]
             wl = self.w_sum - wr
@@ -244,7 +295,7 @@ cdef class _Splitter:
             valid = wl > 0.0 and wr > 0.0
             t.proxy = wyl * wyl / wl + wyr * wyr / wr if valid else -INFINITY
         for j in range(n_hit):
-            self.counts[self.hits[j]] = 0
+            counts[hits[j]] = 0
         return valid
 
     cdef bint find_best(self, BoxTest* best) noexcept nogil:
@@ -265,74 +316,79 @@ cdef class _Splitter:
     cdef intp_t split(self, const BoxTest* best, intp_t* right_lo) noexcept nogil:
         """Send the node's samples and objects left or right; return the first right sample.
 
-        Per type, the left child's objects end up in ``lo[t]:right_lo[t]`` and the right child's
-        in ``right_lo[t]:hi[t]``, each still sorted by x.
+        Per segment, the left child's objects end up in ``lo[g]:right_lo[g]`` and the right
+        child's in ``right_lo[g]:hi[g]``, each still sorted by x.
         """
         cdef intp_t n_hit = self.count(best)
-        cdef intp_t i, j, k, ty, nl, nr
+        cdef coord_t* xs = self.xs
+        cdef coord_t* ys = self.ys
+        cdef int32* sid = self.sid
+        cdef int32* samples = self.samples
+        cdef uint8* goes_right = self.goes_right
+        cdef intp_t i, j, k, g, nl, nr
         cdef int32 s
         for j in range(n_hit):
             s = self.hits[j]
-            self.goes_right[s] = self.counts[s] >= best.threshold
+            goes_right[s] = self.counts[s] >= best.threshold
             self.counts[s] = 0
         i = self.start
         k = self.end
         while i < k:
-            if self.goes_right[self.samples[i]]:
+            if goes_right[samples[i]]:
                 k -= 1
-                self.samples[i], self.samples[k] = self.samples[k], self.samples[i]
+                samples[i], samples[k] = samples[k], samples[i]
             else:
                 i += 1
-        for ty in range(self.n_types):
-            nl = self.lo[ty]
+        for g in range(self.n_types * self.n_bands):
+            nl = self.lo[g]
             nr = 0
-            for k in range(self.lo[ty], self.hi[ty]):
-                s = self.sid[k]
-                if self.goes_right[s]:
-                    self.tmp_x[nr] = self.xs[k]
-                    self.tmp_y[nr] = self.ys[k]
+            for k in range(self.lo[g], self.hi[g]):
+                s = sid[k]
+                if goes_right[s]:
+                    self.tmp_x[nr] = xs[k]
+                    self.tmp_y[nr] = ys[k]
                     self.tmp_sid[nr] = s
                     nr += 1
                 else:
-                    self.xs[nl] = self.xs[k]
-                    self.ys[nl] = self.ys[k]
-                    self.sid[nl] = s
+                    xs[nl] = xs[k]
+                    ys[nl] = ys[k]
+                    sid[nl] = s
                     nl += 1
-            right_lo[ty] = nl
+            right_lo[g] = nl
             for k in range(nr):
-                self.xs[nl + k] = self.tmp_x[k]
-                self.ys[nl + k] = self.tmp_y[k]
-                self.sid[nl + k] = self.tmp_sid[k]
+                xs[nl + k] = self.tmp_x[k]
+                ys[nl + k] = self.tmp_y[k]
+                sid[nl + k] = self.tmp_sid[k]
         for j in range(n_hit):
-            self.goes_right[self.hits[j]] = 0
+            goes_right[self.hits[j]] = 0
         return i
 
 
-cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] type_ptr,
+cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segment_ptr,
                 double min_samples_split, intp_t max_depth) noexcept nogil:
     """Grow the tree depth first; ``nodes`` receives the flat node list."""
-    cdef intp_t n_types = splitter.n_types
+    cdef intp_t n_segments = segment_ptr.shape[0] - 1
     cdef vector[StackRecord] stack
-    cdef vector[intp_t] ranges          # per stacked record: (lo, hi) of every type
+    cdef vector[intp_t] ranges          # per stacked record: (lo, hi) of every segment
     cdef vector[intp_t] right_lo
     cdef StackRecord rec
     cdef Node node
     cdef BoxTest best
-    cdef intp_t ty, i, s, base, node_id, mid
+    cdef intp_t g, i, s, base, node_id, mid
     cdef double w, wy, wy2, y, ymin, ymax
-    right_lo.resize(n_types)
-    stack.push_back(StackRecord(0, splitter.samples.shape[0], 0, TREE_LEAF, False))
-    for ty in range(n_types):
-        ranges.push_back(type_ptr[ty])
-        ranges.push_back(type_ptr[ty + 1])
+    right_lo.resize(n_segments)
+    stack.push_back(StackRecord(0, splitter.n_samples, 0, TREE_LEAF, False))
+    for g in range(n_segments):
+        ranges.push_back(segment_ptr[g])
+        ranges.push_back(segment_ptr[g + 1])
 
     while not stack.empty():
         rec = stack.back()
         stack.pop_back()
-        base = ranges.size() - 2 * n_types
-        for ty in range(n_types):
-            splitter.lo[ty] = ranges[base + 2 * ty]
-            splitter.hi[ty] = ranges[base + 2 * ty + 1]
+        base = ranges.size() - 2 * n_segments
+        for g in range(n_segments):
+            splitter.lo[g] = ranges[base + 2 * g]
+            splitter.hi[g] = ranges[base + 2 * g + 1]
         ranges.resize(base)
 
         w = wy = wy2 = 0.0
@@ -379,29 +435,31 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] type_
         nodes[0][node_id].threshold = best.threshold
         # the left child is pushed last so that it is grown first
         stack.push_back(StackRecord(mid, rec.end, rec.depth + 1, node_id, False))
-        for ty in range(n_types):
-            ranges.push_back(right_lo[ty])
-            ranges.push_back(splitter.hi[ty])
+        for g in range(n_segments):
+            ranges.push_back(right_lo[g])
+            ranges.push_back(splitter.hi[g])
         stack.push_back(StackRecord(rec.start, mid, rec.depth + 1, node_id, True))
-        for ty in range(n_types):
-            ranges.push_back(splitter.lo[ty])
-            ranges.push_back(right_lo[ty])
+        for g in range(n_segments):
+            ranges.push_back(splitter.lo[g])
+            ranges.push_back(right_lo[g])
 
 
-def build_tree(const coord_t[::1] x, const coord_t[::1] y, const int32[::1] sample_of,
-               const intp_t[::1] type_ptr, const float64_t[::1] target,
-               const float64_t[::1] weight, const coord_t[:, ::1] bounds, bint local_x,
-               str test_type, double test_width, intp_t n_tests, double min_samples_split,
-               intp_t max_depth, intp_t max_retries, uint64 seed):
+def build_tree(x, y, sample_of, const intp_t[::1] segment_ptr, band_edges, target, weight,
+               const coord_t[:, ::1] bounds, bint local_x, str test_type, double test_width,
+               intp_t n_tests, double min_samples_split, intp_t max_depth, intp_t max_retries,
+               uint64 seed):
     """Grow one tree and return its node arrays as a dict.
 
     Parameters
     ----------
     x, y, sample_of : arrays of shape (n_objects,)
-        The training objects grouped by type, sorted by x within each type, and the sample
-        each belongs to.
-    type_ptr : array of shape (n_types + 1,)
-        Objects of type ``t`` are ``type_ptr[t]:type_ptr[t + 1]``.
+        The training objects grouped by segment (type, then y band), sorted by x within each
+        segment, and the sample each belongs to.
+    segment_ptr : array of shape (n_types * n_bands + 1,)
+        Segment ``g = type * n_bands + band`` is ``segment_ptr[g]:segment_ptr[g + 1]``.
+    band_edges : array of shape (n_bands + 1,)
+        Band ``b`` holds the objects with ``band_edges[b] <= y < band_edges[b + 1]``; the
+        first edge is -inf and the last +inf.
     target, weight : arrays of shape (n_samples,)
         Regression targets and (strictly positive) sample weights.
     bounds : array of shape (n_types, 4)
@@ -415,11 +473,11 @@ def build_tree(const coord_t[::1] x, const coord_t[::1] y, const int32[::1] samp
         Seed of the tree's random generator.
     """
     cdef _Splitter splitter = _Splitter(
-        x, y, sample_of, target, weight, bounds, local_x, TEST_KINDS[test_type], test_width,
-        n_tests, max_retries, seed)
+        x, y, sample_of, target, weight, band_edges, bounds, local_x, TEST_KINDS[test_type],
+        test_width, n_tests, max_retries, seed)
     cdef vector[Node] nodes
     with nogil:
-        _grow(splitter, &nodes, type_ptr, min_samples_split, max_depth)
+        _grow(splitter, &nodes, segment_ptr, min_samples_split, max_depth)
     return _to_arrays(nodes)
 
 

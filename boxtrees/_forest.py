@@ -17,6 +17,9 @@ __all__ = ["BoxExtraTreesRegressor"]
 
 # below this many samples, prediction runs in the calling thread
 _PARALLEL_PREDICT_MIN_SAMPLES = 2048
+# y bands of the training-object index: at most this many, this many for large boxes
+_MAX_BANDS = 32
+_DEFAULT_BANDS = 8
 
 
 class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
@@ -185,18 +188,24 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         self.bounds_ = self._sampling_region(data)
         local_x = self._fitted_on_features and self.view_bounds is None
 
-        order = np.lexsort((data[:, 0], types))
+        band_edges = self._band_edges()
+        n_bands = len(band_edges) - 1
+        bands = np.searchsorted(band_edges[1:-1], data[:, 1], side="right")
+        segments = types * n_bands + bands
+        order = np.lexsort((data[:, 0], segments))
         x_sorted = np.ascontiguousarray(data[order, 0])
         y_sorted = np.ascontiguousarray(data[order, 1])
         sample_of = sets.sample_index()[order].astype(np.int32)
-        type_ptr = np.searchsorted(types[order], np.arange(self.n_types_ + 1)).astype(np.intp)
+        segment_ptr = np.searchsorted(
+            segments[order], np.arange(self.n_types_ * n_bands + 1)
+        ).astype(np.intp)
 
         rng = check_random_state(self.random_state)
         seeds = rng.randint(np.iinfo(np.int64).max, size=self.n_estimators, dtype=np.int64)
         max_depth = -1 if self.max_depth is None else self.max_depth
         trees = Parallel(n_jobs=self.n_jobs, verbose=self.verbose, prefer="threads")(
             delayed(build_tree)(
-                x_sorted, y_sorted, sample_of, type_ptr, y, sample_weight, self.bounds_,
+                x_sorted, y_sorted, sample_of, segment_ptr, band_edges, y, sample_weight, self.bounds_,
                 local_x, self.test_type, float(self.test_width), self.n_tests,
                 float(self.min_samples_split), max_depth, self.max_retries, int(seed),
             )
@@ -218,6 +227,24 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         if self._fitted_on_features:
             bounds[:, 2:] = [-np.inf, np.inf]
         return np.ascontiguousarray(bounds, dtype=np.float32)
+
+    def _band_edges(self):
+        """Edges of the y bands that index the training objects (an internal speed-up).
+
+        Bands about twice as tall as a fixed or bounded box (measured best) let a test skip
+        most objects of its type; wholly covered bands need no y comparison. Feature-matrix
+        columns have no y.
+        """
+        if self._fitted_on_features:
+            n_bands = 1
+        elif self.test_type in ("fixed", "bounded"):
+            height = float(self.bounds_[0, 3]) - float(self.bounds_[0, 2])
+            n_bands = int(np.clip(np.ceil(height / (4 * self.test_width)), 1, _MAX_BANDS))
+        else:
+            n_bands = _DEFAULT_BANDS
+        y0, y1 = float(self.bounds_[0, 2]), float(self.bounds_[0, 3])
+        inner = y0 + (y1 - y0) * np.arange(1, n_bands) / n_bands
+        return np.concatenate([[-np.inf], inner, [np.inf]])
 
     def _traverse(self, X, kernel, out):
         """Validate ``X`` and run a traversal kernel over its samples, in parallel chunks
