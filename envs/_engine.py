@@ -43,6 +43,27 @@ def _uniforms_per_world(rules):
     return 2 * n_objects + n_treasure + 2 * rules.max_steps
 
 
+def _check_layout(objects, rules):
+    """Validate explicit world objects: a float ``(k, 3)`` array of ``[x, y, type]`` rows."""
+    try:
+        objects = np.asarray(objects, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError("options['objects'] must be a numeric array of rows [x, y, type]") \
+            from None
+    objects = objects.reshape(-1, 3) if objects.size == 0 else objects
+    if objects.ndim != 2 or objects.shape[1] != 3:
+        raise ValueError(f"options['objects'] must have shape (k, 3), got {objects.shape}")
+    if not np.isfinite(objects).all():
+        raise ValueError("options['objects'] contains NaN or infinite values")
+    if (np.abs(objects[:, :2]) > rules.size_w).any():
+        raise ValueError(f"options['objects'] has positions outside [-{rules.size_w}, "
+                         f"{rules.size_w}]^2")
+    if not np.isin(objects[:, 2], [MONEY, WALL, GRASS, ENEMY]).all():
+        raise ValueError("options['objects'] types must be MONEY, WALL, GRASS or ENEMY "
+                         f"({MONEY}-{ENEMY})")
+    return objects
+
+
 def _near_path(rx, ry, sx, sy, radius):
     """Whether points ``(rx, ry)`` lie within `radius` of the segment from 0 to ``(sx, sy)``."""
     along = np.clip((rx * sx + ry * sy) / np.maximum(sx * sx + sy * sy, 1e-12), 0.0, 1.0)
@@ -100,12 +121,9 @@ class _Engine:
         self.n_worlds = n_worlds
         size_w = rules.size_w
         self._border = _border_walls(size_w)
-        n_coins = rules.n_treasure if rules.treasure else 0
         self._n_random = rules.n_money + rules.n_walls + rules.n_grass
-        self._static_types = np.repeat(
-            np.array([WALL, MONEY, WALL, GRASS, MONEY], dtype=np.int8),
-            [len(self._border), rules.n_money, rules.n_walls, rules.n_grass, n_coins])
-        self._n_static = len(self._static_types)
+        self._random_types = np.repeat(np.array([MONEY, WALL, GRASS], dtype=np.int8),
+                                       [rules.n_money, rules.n_walls, rules.n_grass])
         # A step reads the static objects in a window of grid cells around each agent:
         # whatever its path touches or its view holds afterwards lies within `reach`.
         self._grid = math.ceil(2 * size_w / _GRID_CELL)
@@ -120,26 +138,43 @@ class _Engine:
         self.observation = None
 
     # ----------------------------------------------------------------------------------
-    def reset(self, rngs):
+    def reset(self, rngs, layout=None):
         """Draw every world afresh, world ``i`` from ``rngs[i]``.
 
         Each world takes one block of uniforms (object positions, treasure, the episode's
         move noise), then redraws the objects that fell within `start_clearance` of the
         centre (rejection keeps the density uniform outside it).
+
+        Parameters
+        ----------
+        rngs : list of numpy.random.Generator
+            One per world.
+        layout : ndarray of shape (k, 3), optional
+            Rows ``[x, y, type]`` (checked by `_check_layout`) that replace the random
+            objects of every world; the border, the treasure and the noise are still drawn.
         """
         rules, n = self.rules, self.n_worlds
         size_w = rules.size_w
         n_uniforms = _uniforms_per_world(rules)
         u = np.stack([rng.random(n_uniforms) for rng in rngs])
         n_objects = self._n_random + rules.n_enemies
-        objects = (2 * size_w) * u[:, :2 * n_objects].reshape(n, n_objects, 2) - size_w
-        clearance2 = rules.start_clearance ** 2
-        near = (objects * objects).sum(axis=2) < clearance2
-        for i in np.flatnonzero(near.any(axis=1)):
-            while near[i].any():
-                objects[i, near[i]] = (2 * size_w) * rngs[i].random((near[i].sum(), 2)) - size_w
-                near[i] = (objects[i] * objects[i]).sum(axis=1) < clearance2
         used = 2 * n_objects
+        if layout is None:
+            objects = (2 * size_w) * u[:, :used].reshape(n, n_objects, 2) - size_w
+            clearance2 = rules.start_clearance ** 2
+            near = (objects * objects).sum(axis=2) < clearance2
+            for i in np.flatnonzero(near.any(axis=1)):
+                while near[i].any():
+                    objects[i, near[i]] = (2 * size_w) * rngs[i].random((near[i].sum(), 2)) - size_w
+                    near[i] = (objects[i] * objects[i]).sum(axis=1) < clearance2
+            random_types = self._random_types
+            enemies = objects[:, self._n_random:]
+            objects = objects[:, :self._n_random]
+        else:
+            is_enemy = layout[:, 2] == ENEMY
+            random_types = layout[~is_enemy, 2].astype(np.int8)
+            enemies = np.broadcast_to(layout[is_enemy, :2], (n, is_enemy.sum(), 2))
+            objects = np.broadcast_to(layout[~is_enemy, :2], (n, len(random_types), 2))
         coins = np.empty((n, 0, 2))
         self._treasure = np.zeros((n, 2))
         if rules.treasure:
@@ -157,18 +192,22 @@ class _Engine:
             used += 2 + 2 * rules.n_treasure
         self._noise = rules.move_noise * (2 * u[:, used:].reshape(n, rules.max_steps, 2) - 1)
 
-        self._ex = objects[:, self._n_random:, 0].copy()
-        self._ey = objects[:, self._n_random:, 1].copy()
-        self._enemy_alive = np.ones((n, rules.n_enemies), dtype=bool)
+        self._ex = enemies[..., 0].copy()
+        self._ey = enemies[..., 1].copy()
+        self._enemy_alive = np.ones(self._ex.shape, dtype=bool)
         self.agent = np.zeros((n, 2))
         self.t = 0
 
         # Static objects, sorted world by world and then by grid cell.
         statics = np.concatenate([np.broadcast_to(self._border, (n,) + self._border.shape),
-                                  objects[:, :self._n_random], coins], axis=1)
+                                  objects, coins], axis=1)
+        static_types = np.concatenate([np.full(len(self._border), WALL, dtype=np.int8),
+                                       random_types,
+                                       np.full(coins.shape[1], MONEY, dtype=np.int8)])
+        self._n_static = len(static_types)
         cells = self._cell_index(statics[..., 0], statics[..., 1], _GRID_CELL, self._grid)
         order = np.argsort(cells.astype(np.int16), axis=1, kind="stable")  # radix sort
-        self._types = self._static_types[order].ravel()
+        self._types = static_types[order].ravel()
         order = (order + self._n_static * np.arange(n)[:, None]).ravel()
         cells = cells.ravel()[order]
         self._x = statics[..., 0].ravel()[order]

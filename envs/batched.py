@@ -9,7 +9,7 @@ from gymnasium.vector.utils import batch_space
 
 from ._engine import _Engine
 from ._rules import WorldRules
-from .object_world import _object_space
+from .object_world import _layout_from_options, _object_space
 
 __all__ = ["BatchedObjectWorld", "RaggedBatch"]
 
@@ -168,19 +168,21 @@ class BatchedObjectWorld(VectorEnv):
         seed : None, int or sequence of int, default=None
             An int ``s`` seeds world ``i`` with ``s + i``; a sequence gives one seed per
             world. None continues each world's generator (fresh entropy the first time).
-        options : None
-            Unused.
+        options : dict, optional
+            ``{"objects": rows}`` places the same objects in every world instead of the
+            random ones, as in `ObjectWorldEnv.reset`.
 
         Returns
         -------
         obs : RaggedBatch
         info : dict
         """
+        layout = _layout_from_options(options, self.rules)
         if seed is not None:
             self._rngs = [seeding.np_random(s)[0] for s in _world_seeds(seed, self.num_envs)]
         elif self._rngs is None:
             self._rngs = [seeding.np_random()[0] for _ in range(self.num_envs)]
-        self._engine.reset(self._rngs)
+        self._engine.reset(self._rngs, layout)
         self._autoreset = False
         return RaggedBatch(*self._engine.observation), {}
 

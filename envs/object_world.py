@@ -3,7 +3,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from ._engine import _Engine
+from ._engine import _check_layout, _Engine
 from ._render import render_local, render_world
 from ._rules import WorldRules
 
@@ -19,6 +19,16 @@ def _object_space(rules):
                      high=np.array([bound, bound, rules.n_types - 1], dtype=np.float32),
                      dtype=np.float32)
     return spaces.Sequence(row, stack=True)
+
+
+def _layout_from_options(options, rules):
+    """The explicit object layout of ``reset(options={"objects": rows})``, or None."""
+    if options is None:
+        return None
+    if not isinstance(options, dict) or set(options) - {"objects"}:
+        raise ValueError(f"reset options must be None or a dict with the only key 'objects', "
+                         f"got {options!r}")
+    return _check_layout(options["objects"], rules) if "objects" in options else None
 
 
 def _check_action(action, n_actions):
@@ -112,11 +122,29 @@ class ObjectWorldEnv(gym.Env):
         return self.rules.view_size
 
     def reset(self, *, seed=None, options=None):
+        """Draw a new world from ``self.np_random``.
+
+        Parameters
+        ----------
+        seed : int, optional
+            Reseeds ``self.np_random`` first.
+        options : dict, optional
+            ``{"objects": rows}``: an array of rows ``[x, y, type]`` (world coordinates,
+            types `MONEY`, `WALL`, `GRASS`, `ENEMY`) placed instead of the random objects; the
+            border walls, the treasure and the move noise are drawn as usual. For scripted
+            situations and tests.
+
+        Returns
+        -------
+        observation : ndarray of float32 of shape (n, 3)
+        info : dict
+        """
         super().reset(seed=seed)
-        self._engine.reset([self.np_random])
+        self._engine.reset([self.np_random], _layout_from_options(options, self.rules))
         return self._engine.observation[0], {}
 
     def step(self, action):
+        """Apply `action`; returns ``(observation, reward, terminated, truncated, info)``."""
         action = _check_action(action, self.rules.n_actions)
         if self._engine.observation is None:
             raise RuntimeError("call reset() before step()")
@@ -127,6 +155,7 @@ class ObjectWorldEnv(gym.Env):
         return self._engine.observation[0], float(rewards[0]), False, truncated, {}
 
     def render(self):
+        """An RGB frame (uint8, ``(side, side, 3)``) of the world or of the local view."""
         if self.render_mode is None:
             gym.logger.warn("render() called without render_mode; pass render_mode='rgb_array'")
             return None

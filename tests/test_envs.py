@@ -1,0 +1,400 @@
+"""The ObjectWorld rules, the gymnasium API, rendering, wrappers and bad input."""
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import envs
+from envs import ENEMY, GRASS, MONEY, WALL
+
+IDS = ["ObjectWorld-v0", "ObjectWorldSword-v0", "ObjectWorldTreasure-v0"]
+UP, RIGHT, DOWN, LEFT, SWIPE_UP, SWIPE_RIGHT = 0, 1, 2, 3, 4, 5
+
+
+def scripted(objects, **rules):
+    """A noise-free env with static enemies whose world holds exactly `objects`."""
+    rules = {"move_noise": 0.0, "enemy_speed": 0.0, **rules}
+    env = envs.ObjectWorldEnv(**rules)
+    obs, _ = env.reset(seed=0, options={"objects": np.array(objects, dtype=float).reshape(-1, 3)})
+    return env, obs
+
+
+def of_type(obs, kind):
+    return obs[obs[:, 2] == kind, :2]
+
+
+# --------------------------------------------------------------------------- gymnasium API
+@pytest.mark.parametrize("env_id", IDS)
+def test_check_env_every_id(env_id):
+    check_env(gym.make(env_id, render_mode="rgb_array").unwrapped)
+
+
+@pytest.mark.parametrize("view", envs.VIEWS)
+def test_check_env_every_treasure_view(view):
+    check_env(gym.make("ObjectWorldTreasure-v0", view=view, render_mode="rgb_array").unwrapped)
+
+
+def test_spaces_and_type_constants():
+    assert (envs.MONEY, envs.WALL, envs.GRASS, envs.ENEMY) == (0, 1, 2, 3)
+    assert {envs.MONEY_MARKER, envs.TREASURE_MARKER, envs.ARROW} == {4, 5, 6}
+    assert gym.make("ObjectWorld-v0").action_space == gym.spaces.Discrete(4)
+    assert gym.make("ObjectWorldSword-v0").action_space == gym.spaces.Discrete(8)
+    sizes = {view: gym.make("ObjectWorldTreasure-v0", view=view).unwrapped.n_types
+             for view in envs.VIEWS}
+    assert sizes == {"local": 4, "global": 4, "minimap": 6, "arrow": 7}
+    space = envs.ObjectWorldEnv().observation_space
+    assert isinstance(space, gym.spaces.Sequence) and space.stack
+    assert space.feature_space.shape == (3,) and space.feature_space.dtype == np.float32
+
+
+def test_episode_truncates_after_max_steps_and_reset_draws_new_world():
+    env = envs.ObjectWorldEnv()
+    first, _ = env.reset(seed=1)
+    for t in range(50):
+        obs, reward, terminated, truncated, _ = env.step(t % 4)
+        assert obs.dtype == np.float32 and obs.ndim == 2 and obs.shape[1] == 3
+        assert isinstance(reward, float) and not terminated
+        assert truncated == (t == 49)
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(0)
+    second, _ = env.reset()
+    assert not np.array_equal(first, second)
+    assert np.array_equal(first, env.reset(seed=1)[0])
+
+
+def test_world_seeds_reproduce_and_differ():
+    a, b = envs.ObjectWorldEnv(), envs.ObjectWorldEnv()
+    assert np.array_equal(a.reset(seed=7)[0], b.reset(seed=7)[0])
+    assert not np.array_equal(a.reset(seed=7)[0], b.reset(seed=8)[0])
+    actions = [1, 1, 0, 3, 2, 2, 1]
+    assert [a.step(x)[1:4] for x in actions] == [b.step(x)[1:4] for x in actions]
+
+
+def test_reference_worlds_are_fixed_and_disjoint_from_training_seeds():
+    seeds = envs.reference_worlds(400)
+    assert seeds == envs.reference_worlds(400) and len(set(seeds)) == 400
+    assert min(seeds) == envs.REFERENCE_SEED_START >= 2**32
+    assert envs.reference_worlds(3) == seeds[:3]
+
+
+# --------------------------------------------------------------------------- rules
+def test_money_is_collected_once_and_removed():
+    env, obs = scripted([[1, 0, MONEY]])
+    assert len(of_type(obs, MONEY)) == 1
+    obs, reward, *_ = env.step(RIGHT)
+    assert reward == 100.0 and len(of_type(obs, MONEY)) == 0
+    assert env.step(LEFT)[1] == 0.0 and env.step(RIGHT)[1] == 0.0
+
+
+def test_money_on_the_path_is_collected_without_landing_on_it():
+    env, _ = scripted([[0.5, 0.55, MONEY]])  # 0.55 from the path, 0.74 from either end
+    assert env.step(RIGHT)[1] == 100.0
+
+
+def test_wall_blocks_and_costs_50():
+    env, before = scripted([[1.3, 0, WALL], [0, 5, GRASS]])
+    after, reward, *_ = env.step(RIGHT)
+    assert reward == -50.0
+    np.testing.assert_array_equal(after, before)  # the agent did not move
+    assert env.step(UP)[1] == 0.0  # other directions are free
+
+
+def test_wall_blocks_the_whole_move_so_money_behind_it_stays():
+    env, _ = scripted([[0.4, 0, MONEY], [1.0, 0, WALL]])
+    obs, reward, *_ = env.step(RIGHT)
+    assert reward == -50.0 and len(of_type(obs, MONEY)) == 1
+
+
+def test_grass_does_nothing():
+    env, _ = scripted([[1, 0, GRASS]])
+    obs, reward, *_ = env.step(RIGHT)
+    assert reward == 0.0
+    np.testing.assert_allclose(of_type(obs, GRASS), [[0.0, 0.0]], atol=1e-6)
+
+
+def test_enemy_contact_costs_300_and_removes_it():
+    env, _ = scripted([[1, 0, ENEMY], [1, 0.2, ENEMY], [0, 4, ENEMY]])
+    obs, reward, *_ = env.step(RIGHT)
+    assert reward == -600.0
+    np.testing.assert_allclose(of_type(obs, ENEMY), [[-1, 4]], atol=1e-6)
+
+
+def test_enemies_in_view_chase_slower_than_the_agent_and_others_wait():
+    env, obs = scripted([[5, 0, ENEMY], [0, -15, ENEMY]], enemy_speed=0.2,
+                        view="global")
+    obs, reward, *_ = env.step(LEFT)
+    near, far = of_type(obs, ENEMY)
+    np.testing.assert_allclose(near, [6 - 0.2, 0], atol=1e-6)  # gap grew by 1 - 0.2
+    np.testing.assert_allclose(far, [1, -15], atol=1e-6)  # outside the view: static
+    assert reward == 0.0
+
+
+def test_enemy_reaching_the_agent_hurts():
+    env, _ = scripted([[0, 2.0, ENEMY]], enemy_speed=0.7)
+    rewards = [env.step(RIGHT if t % 2 else LEFT)[1] for t in range(4)]
+    assert rewards.count(-300.0) == 1 and rewards[-1] == 0.0
+
+
+def test_move_noise_is_uniform_within_a_tenth():
+    env = envs.ObjectWorldEnv(n_money=0, n_walls=0, n_grass=0, n_enemies=0)
+    steps = []
+    for seed in range(8):
+        obs, _ = env.reset(seed=seed, options={"objects": [[0, 9, GRASS]]})
+        for _ in range(5):
+            new, *_ = env.step(RIGHT)
+            steps.append(of_type(obs, GRASS)[0] - of_type(new, GRASS)[0])
+            obs = new
+    noise = np.array(steps) - [1.0, 0.0]
+    assert np.abs(noise).max() <= 0.1 + 1e-6
+    assert noise.std(axis=0).min() > 0.03  # really random, on both coordinates
+
+
+@pytest.mark.parametrize("enemies, expected, left", [
+    ([[0, 2, ENEMY]], 300.0, 0),
+    ([[0.5, 1.5, ENEMY], [-0.5, 2.5, ENEMY]], -900.0, 2),
+    ([[0.4, 1.2, ENEMY], [1.0, 2.0, ENEMY], [-1.0, 2.9, ENEMY]], -900.0, 3),
+    ([], -750.0, 0),
+    ([[0, 3.3, ENEMY], [1.7, 1, ENEMY], [0, -2, ENEMY]], -750.0, 3),  # all outside the square
+])
+def test_swipe_rewards(enemies, expected, left):
+    env, _ = scripted(enemies + [[0, 2, WALL]], sword=True)
+    obs, reward, *_ = env.step(SWIPE_UP)
+    assert reward == expected
+    assert len(of_type(obs, ENEMY)) == left
+    assert len(of_type(obs, WALL)) == 1  # walls are not hit, the agent did not move
+
+
+def test_swipe_directions():
+    env, _ = scripted([[2, 0, ENEMY]], sword=True)
+    assert env.step(SWIPE_UP)[1] == -750.0
+    assert env.step(SWIPE_RIGHT)[1] == 300.0
+
+
+def test_border_walls_hold_the_agent_in():
+    env = envs.ObjectWorldEnv(n_money=0, n_walls=0, n_grass=0, n_enemies=0, max_steps=50)
+    obs, _ = env.reset(seed=3)
+    rewards = []
+    for _ in range(45):
+        obs, reward, *_ = env.step(RIGHT)
+        rewards.append(reward)
+    walls = of_type(obs, WALL)
+    assert len(walls) > 10 and np.allclose(walls[:, 0], walls[0, 0])  # one straight border
+    assert 0.6 <= walls[0, 0] <= 1.8  # stopped just before it
+    assert rewards[:28] == [0.0] * 28 and rewards[-10:] == [-50.0] * 10
+
+
+def test_view_is_clipped_to_ten_units():
+    env, obs = scripted([[9.9, -9.9, GRASS], [10.2, 0, GRASS], [0, -10.4, MONEY]])
+    np.testing.assert_allclose(obs, [[9.9, -9.9, GRASS]], atol=1e-6)
+    env = envs.ObjectWorldEnv()
+    env.reset(seed=0)
+    for t in range(50):
+        obs = env.step(t % 4)[0]
+        assert np.abs(obs[:, :2]).max() <= 10.0
+
+
+def test_global_view_sees_every_object():
+    env = envs.ObjectWorldEnv(view="global")
+    obs, _ = env.reset(seed=0)
+    n_border = 4 * 60
+    assert len(obs) == n_border + 40 + 30 + 30 + 13
+    assert np.abs(obs[:, :2]).max() > 25
+
+
+def test_treasure_stack_lies_near_a_border():
+    env = envs.ObjectWorldEnv(treasure=True, view="global", n_money=0)
+    for seed in range(5):
+        obs, _ = env.reset(seed=seed)
+        coins = of_type(obs, MONEY)  # the agent starts at the centre: world coordinates
+        assert len(coins) == 20
+        centre = coins.mean(axis=0)
+        assert np.linalg.norm(coins - centre, axis=1).max() <= 2.0
+        assert abs(np.abs(centre).max() - 27.0) <= 1.0  # 3 units inside one side
+
+
+def test_minimap_markers_disappear_once_the_cell_is_visited():
+    env = envs.ObjectWorldEnv(treasure=True, view="minimap", move_noise=0.0)
+    obs, _ = env.reset(seed=0, options={"objects": [[15, 0, MONEY]]})
+    east = (20 - 0) / 6  # the east cell's centre, world shrunk 6 times into the view
+    markers = of_type(obs, envs.MONEY_MARKER)
+    assert len(markers) >= 1 and len(of_type(obs, envs.TREASURE_MARKER)) == 1
+    assert np.any(np.all(np.isclose(markers, [east, 0], atol=1e-5), axis=1))
+    assert not np.any(np.all(np.isclose(markers, [0, 0], atol=1e-5), axis=1))  # start cell
+    for _ in range(11):
+        obs = env.step(RIGHT)[0]
+    markers = of_type(obs, envs.MONEY_MARKER)
+    assert not np.any(np.isclose(markers[:, 0], (20 - 11) / 6, atol=1e-5) & (markers[:, 1] == 0))
+    assert len(of_type(obs, MONEY)) == 1  # left the money, yet the marker went
+
+
+def test_treasure_marker_goes_when_its_cell_is_visited():
+    env = envs.ObjectWorldEnv(treasure=True, view="minimap", n_enemies=0, n_walls=0,
+                              n_grass=0, n_money=0, max_steps=50)
+    obs, _ = env.reset(seed=4)
+    mark = of_type(obs, envs.TREASURE_MARKER)[0]
+    direction = np.argmax([mark[1], mark[0], -mark[1], -mark[0]])  # walk toward it
+    for _ in range(25):
+        obs = env.step(direction)[0]
+    assert len(of_type(obs, envs.TREASURE_MARKER)) == 0
+
+
+def test_arrow_points_at_the_treasure():
+    arrow_env = envs.ObjectWorldEnv(treasure=True, view="arrow", n_money=0)
+    global_env = envs.ObjectWorldEnv(treasure=True, view="global", n_money=0)
+    for seed in range(5):
+        obs, _ = arrow_env.reset(seed=seed)
+        world, _ = global_env.reset(seed=seed)  # same seed: same treasure
+        for action in [0, 1, 1, 2]:
+            obs, world = arrow_env.step(action)[0], global_env.step(action)[0]
+        (arrow,) = of_type(obs, envs.ARROW)
+        goal = of_type(world, MONEY).mean(axis=0)
+        assert np.linalg.norm(arrow) == pytest.approx(9.0, rel=1e-5)
+        cosine = arrow @ goal / (np.linalg.norm(arrow) * np.linalg.norm(goal))
+        assert cosine > 0.998
+
+
+def test_rng_draws_do_not_depend_on_the_view():
+    seen = [envs.ObjectWorldEnv(treasure=True, view=v).reset(seed=2)[0] for v in envs.VIEWS]
+    local = seen[0]
+    for obs in seen[1:]:
+        keep = np.isin(obs[:, 2], [MONEY, WALL, GRASS, ENEMY]) & (np.abs(obs[:, :2]) <= 10).all(1)
+        np.testing.assert_array_equal(np.sort(obs[keep], axis=0), np.sort(local, axis=0))
+
+
+# --------------------------------------------------------------------------- rendering
+@pytest.mark.parametrize("render_view", ["world", "local"])
+def test_render_draws_objects_agent_and_view(render_view):
+    env = envs.ObjectWorldEnv(render_mode="rgb_array", render_view=render_view)
+    env.reset(seed=0)
+    frame = env.render()
+    assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
+    assert 400 <= frame.shape[0] == frame.shape[1] <= 600
+    colours = {tuple(c) for c in frame.reshape(-1, 3)}
+    for kind in (MONEY, WALL, ENEMY):
+        assert envs._render._STYLE[kind][0] in colours
+    assert envs._render._VIEW_COLOUR in colours and envs._render._AGENT[0] in colours
+    env.step(1)
+    assert not np.array_equal(frame, env.render())
+
+
+def test_render_without_mode_warns_and_returns_none():
+    env = envs.ObjectWorldEnv()
+    env.reset(seed=0)
+    with pytest.warns(UserWarning, match="render_mode"):
+        assert env.render() is None
+
+
+# --------------------------------------------------------------------------- wrappers, policy
+def test_padded_objects_round_trip():
+    env = envs.PaddedObjects(envs.ObjectWorldEnv(), max_objects=128)
+    inner = env.unwrapped
+    obs, _ = env.reset(seed=0)
+    raw = inner._engine.observation[0]
+    assert obs.shape == (128, 4) and env.observation_space.contains(obs)
+    (stripped,) = envs.strip_padding(obs)
+    np.testing.assert_array_equal(stripped, raw)
+    assert obs[len(raw):].sum() == 0.0 and (obs[:len(raw), 3] == 1).all()
+    batch = envs.strip_padding(np.stack([obs, obs]))
+    assert len(batch) == 2 and np.array_equal(batch[1], raw)
+
+
+def test_padded_objects_keeps_the_nearest_when_full():
+    env = envs.PaddedObjects(envs.ObjectWorldEnv(move_noise=0.0), max_objects=2)
+    obs, _ = env.reset(seed=0, options={"objects": [[5, 5, GRASS], [1, 0, GRASS], [0, 2, MONEY]]})
+    np.testing.assert_array_equal(envs.strip_padding(obs)[0], [[1, 0, GRASS], [0, 2, MONEY]])
+
+
+def test_greedy_policy_beats_random_play():
+    worlds = envs.BatchedObjectWorld(40, sword=True)
+    policy = envs.GreedyPolicy(worlds)
+    totals = []
+    for greedy in (False, True):
+        obs, _ = worlds.reset(seed=100)
+        rng = np.random.default_rng(0)
+        total = 0.0
+        for _ in range(50):
+            actions = policy.predict(obs)[0] if greedy else rng.integers(8, size=40)
+            obs, rewards, *_ = worlds.step(actions)
+            total += rewards.sum()
+        totals.append(total)
+    assert totals[0] < -200_000 and totals[1] > 0
+    single = envs.ObjectWorldEnv(sword=True)
+    obs, _ = single.reset(seed=100)
+    assert policy.predict(obs)[0] == policy.predict(worlds.reset(seed=100)[0])[0][0]
+
+
+# --------------------------------------------------------------------------- bad input
+@pytest.mark.parametrize("action", [4, -1, 1.0, "up", None, np.array([1]), True])
+def test_invalid_action_is_a_value_error(action):
+    env = envs.ObjectWorldEnv()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="invalid action"):
+        env.step(action)
+
+
+def test_sword_actions_need_the_sword():
+    env = envs.ObjectWorldEnv(sword=True)
+    env.reset(seed=0)
+    env.step(7)
+    with pytest.raises(ValueError, match=r"\[0, 8\)"):
+        env.step(8)
+
+
+@pytest.mark.parametrize("rules, match", [
+    ({"view": "birdseye"}, "unknown view"),
+    ({"view": "arrow"}, "treasure=True"),
+    ({"n_money": -1}, "n_money must be >= 0"),
+    ({"n_enemies": -3}, "n_enemies must be >= 0"),
+    ({"n_walls": 2.5}, "n_walls must be an int"),
+    ({"max_steps": 0}, "max_steps must be >= 1"),
+    ({"size_w": float("nan")}, "size_w must be a finite number"),
+    ({"contact_radius": 0.3}, "contact_radius"),
+    ({"enemy_speed": -0.1}, "enemy_speed"),
+    ({"view_size": 0}, "view_size"),
+    ({"sword": "yes"}, "sword must be a bool"),
+])
+def test_bad_rules_are_value_errors(rules, match):
+    with pytest.raises(ValueError, match=match):
+        envs.ObjectWorldEnv(**rules)
+    with pytest.raises(ValueError, match=match):
+        envs.BatchedObjectWorld(2, **rules)
+
+
+def test_unknown_rule_is_a_type_error():
+    with pytest.raises(TypeError, match="n_coins"):
+        envs.ObjectWorldEnv(n_coins=3)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"render_mode": "human"}, "render_mode"),
+    ({"render_view": "minimap"}, "render_view"),
+])
+def test_bad_render_arguments(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        envs.ObjectWorldEnv(**kwargs)
+
+
+@pytest.mark.parametrize("options, match", [
+    ({"objects": [[0, 1]]}, r"shape \(k, 3\)"),
+    ({"objects": [[0, 1, 7]]}, "types"),
+    ({"objects": [[0, 99, 0]]}, "outside"),
+    ({"objects": [[0, np.nan, 0]]}, "NaN"),
+    ({"objects": "wall"}, "numeric"),
+    ({"layout": []}, "only key"),
+])
+def test_bad_reset_options(options, match):
+    with pytest.raises(ValueError, match=match):
+        envs.ObjectWorldEnv().reset(seed=0, options=options)
+
+
+def test_bad_wrapper_input():
+    with pytest.raises(ValueError, match="max_objects"):
+        envs.PaddedObjects(envs.ObjectWorldEnv(), 0)
+    with pytest.raises(ValueError, match="Sequence"):
+        envs.PaddedObjects(gym.make("CartPole-v1"), 8)
+    with pytest.raises(ValueError, match="valid"):
+        envs.strip_padding(np.zeros((8, 3)))
+    with pytest.raises(ValueError, match="valid"):
+        envs.strip_padding(np.zeros(4))
+    with pytest.raises(ValueError, match="non-negative"):
+        envs.reference_worlds(-1)

@@ -1,0 +1,167 @@
+"""`BatchedObjectWorld` gives exactly the transitions of the single env, and its API."""
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import envs
+
+VARIANTS = [
+    {},
+    {"sword": True},
+    {"treasure": True},
+    {"treasure": True, "view": "global"},
+    {"treasure": True, "view": "minimap"},
+    {"treasure": True, "view": "arrow"},
+    {"sword": True, "enemy_speed": 0.9, "n_enemies": 60, "size_w": 12.5, "view_size": 4.0},
+]
+
+
+@pytest.mark.parametrize("rules", VARIANTS, ids=lambda r: ",".join(f"{k}={v}" for k, v in r.items()) or "default")
+def test_batched_equals_single_step_by_step(rules):
+    n, seeds = 6, [11, 12, 13, 14, 15, 10**12]
+    worlds = envs.BatchedObjectWorld(n, **rules)
+    singles = [envs.ObjectWorldEnv(**rules) for _ in range(n)]
+    obs, _ = worlds.reset(seed=seeds)
+    expected = [env.reset(seed=s)[0] for env, s in zip(singles, seeds)]
+    rng = np.random.default_rng(0)
+    greedy = envs.GreedyPolicy(worlds)
+    n_steps = 0
+    for episode in range(3):  # the second and third episodes continue the generators
+        for t in range(50):
+            for i in range(n):
+                np.testing.assert_array_equal(obs[i], expected[i])
+            if episode == 1:  # a sensible policy visits other situations than random play
+                actions = greedy.predict(obs)[0]
+            else:
+                actions = rng.integers(worlds.single_action_space.n, size=n)
+            obs, rewards, terminated, truncated, _ = worlds.step(actions)
+            for i, env in enumerate(singles):
+                expected[i], reward, term, trunc, _ = env.step(actions[i])
+                assert (rewards[i], terminated[i], truncated[i]) == (reward, term, trunc)
+            n_steps += 1
+        assert truncated.all()
+        obs, _ = worlds.reset()
+        expected = [env.reset()[0] for env in singles]
+    assert n_steps == 150
+
+
+def test_int_seed_gives_world_i_seed_plus_i():
+    worlds = envs.BatchedObjectWorld(3)
+    obs, _ = worlds.reset(seed=40)
+    for i in range(3):
+        np.testing.assert_array_equal(obs[i], envs.ObjectWorldEnv().reset(seed=40 + i)[0])
+
+
+def test_worlds_do_not_depend_on_their_neighbours():
+    small, _ = envs.BatchedObjectWorld(2).reset(seed=[5, 6])
+    large, _ = envs.BatchedObjectWorld(50).reset(seed=[5] + list(range(100, 148)) + [6])
+    np.testing.assert_array_equal(small[0], large[0])
+    np.testing.assert_array_equal(small[1], large[49])
+
+
+def test_observation_is_a_ragged_batch():
+    worlds = envs.BatchedObjectWorld(5)
+    obs, info = worlds.reset(seed=0)
+    assert isinstance(obs, envs.RaggedBatch) and info == {}
+    assert obs.data.dtype == np.float32 and obs.data.flags.c_contiguous
+    assert obs.data.shape == (obs.offsets[-1], 3) and obs.offsets.dtype == np.intp
+    assert len(obs) == 5 and [len(o) for o in obs] == obs.sizes.tolist()
+    np.testing.assert_array_equal(obs[-1], obs[4])
+    np.testing.assert_array_equal(np.concatenate(list(obs)), obs.data)
+    assert worlds.observation_space.contains(tuple(obs))
+    assert all(worlds.single_observation_space.contains(o) for o in obs)
+    with pytest.raises(IndexError):
+        obs[5]
+
+
+def test_vector_env_attributes():
+    worlds = envs.BatchedObjectWorld(7, sword=True, view_size=8.0)
+    assert isinstance(worlds, gym.vector.VectorEnv)
+    assert worlds.num_envs == 7 and worlds.n_types == 4 and worlds.view_size == 8.0
+    assert worlds.single_action_space == gym.spaces.Discrete(8)
+    assert worlds.action_space.shape == (7,)
+    assert worlds.metadata["autoreset_mode"] == gym.vector.AutoresetMode.NEXT_STEP
+
+
+def test_step_after_truncation_autoresets_next_step():
+    worlds = envs.BatchedObjectWorld(3, max_steps=4)
+    worlds.reset(seed=1)
+    for _ in range(4):
+        _, rewards, _, truncated, _ = worlds.step(np.ones(3, dtype=int))
+    assert truncated.all()
+    obs, rewards, terminated, truncated, _ = worlds.step(np.ones(3, dtype=int))
+    assert not truncated.any() and not terminated.any() and (rewards == 0).all()
+    fresh = [env.reset(seed=1 + i)[0] for i, env in enumerate(
+        [envs.ObjectWorldEnv(max_steps=4) for _ in range(3)])]
+    singles = [envs.ObjectWorldEnv(max_steps=4) for _ in range(3)]
+    for i, env in enumerate(singles):
+        env.reset(seed=1 + i)
+        np.testing.assert_array_equal(obs[i], env.reset()[0])  # continued generator
+    assert not np.array_equal(obs[0], fresh[0])
+    assert worlds.step(np.ones(3, dtype=int))[1].shape == (3,)
+
+
+def test_rewards_and_flags_types():
+    worlds = envs.BatchedObjectWorld(4)
+    worlds.reset(seed=0)
+    _, rewards, terminated, truncated, info = worlds.step(np.array([0, 1, 2, 3]))
+    assert rewards.dtype == np.float64 and rewards.shape == (4,)
+    assert terminated.dtype == bool and truncated.dtype == bool and info == {}
+
+
+def test_layout_option_applies_to_every_world():
+    worlds = envs.BatchedObjectWorld(3, move_noise=0.0)
+    obs, _ = worlds.reset(seed=0, options={"objects": [[1, 0, envs.MONEY]]})
+    _, rewards, *_ = worlds.step(np.array([1, 1, 3]))
+    assert rewards.tolist() == [100.0, 100.0, 0.0]
+
+
+# --------------------------------------------------------------------------- bad input
+@pytest.mark.parametrize("actions, match", [
+    (np.zeros(3, dtype=int), r"shape \(4,\)"),
+    (np.zeros((4, 1), dtype=int), r"shape \(4,\)"),
+    (0, r"shape \(4,\)"),
+    (np.zeros(4), "ints"),
+    (np.array([0, 1, 2, 4]), "invalid action 4"),
+    (np.array([0, -1, 2, 3]), "invalid action -1"),
+])
+def test_bad_actions(actions, match):
+    worlds = envs.BatchedObjectWorld(4)
+    worlds.reset(seed=0)
+    with pytest.raises(ValueError, match=match):
+        worlds.step(actions)
+
+
+@pytest.mark.parametrize("seed, match", [
+    ([1, 2], "2 entries for 3 worlds"),
+    ([1, 2, -3], "non-negative"),
+    ([1, 2, 3.5], "non-negative ints"),
+    (-1, "non-negative"),
+    ("abc", "non-negative ints, got 'a'"),
+    (2.5, "sequence of 3 ints"),
+])
+def test_bad_seeds(seed, match):
+    with pytest.raises(ValueError, match=match):
+        envs.BatchedObjectWorld(3).reset(seed=seed)
+
+
+@pytest.mark.parametrize("n_worlds", [0, -2, 2.0, True])
+def test_bad_n_worlds(n_worlds):
+    with pytest.raises(ValueError, match="n_worlds"):
+        envs.BatchedObjectWorld(n_worlds)
+
+
+def test_step_before_reset():
+    with pytest.raises(RuntimeError, match="reset"):
+        envs.BatchedObjectWorld(2).step(np.zeros(2, dtype=int))
+    with pytest.raises(RuntimeError, match="reset"):
+        envs.ObjectWorldEnv().step(0)
+
+
+def test_ragged_batch_validates():
+    with pytest.raises(ValueError, match=r"shape \(N, 3\)"):
+        envs.RaggedBatch(np.zeros((2, 2)), [0, 2])
+    with pytest.raises(ValueError, match="offsets"):
+        envs.RaggedBatch(np.zeros((2, 3)), [0, 3])
+    with pytest.raises(TypeError, match="ints"):
+        envs.RaggedBatch(np.zeros((2, 3)), [0, 2])[0.5]
