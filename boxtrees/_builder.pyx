@@ -57,33 +57,38 @@ cdef struct StackRecord:
     bint is_left
 
 
-# Branch-free binary searches (the comparison compiles to a conditional move): the positions
-# searched are random, so a branchy search would mispredict half of its steps.
+# Searches in sorted coordinates: branch-free halving (the comparison compiles to a conditional
+# move; the positions searched are random, so a branchy search would mispredict half of its
+# steps) down to a short run, which a vectorisable count finishes.
+
+cdef enum:
+    LINEAR_RUN = 32
+
 
 cdef inline intp_t _first_above(const coord_t* x, intp_t lo, intp_t hi, coord_t v) noexcept nogil:
     """First index in [lo, hi) of sorted ``x`` with x > v (hi if none)."""
     cdef const coord_t* base = x + lo
-    cdef intp_t n = hi - lo, half
-    if n == 0:
-        return lo
-    while n > 1:
+    cdef intp_t n = hi - lo, half, i, below = 0
+    while n > LINEAR_RUN:
         half = n >> 1
         base = base + half if base[half] <= v else base
         n -= half
-    return (base - x) + (base[0] <= v)
+    for i in range(n):
+        below += base[i] <= v
+    return (base - x) + below
 
 
 cdef inline intp_t _first_not_below(const coord_t* x, intp_t lo, intp_t hi, coord_t v) noexcept nogil:
     """First index in [lo, hi) of sorted ``x`` with x >= v (hi if none)."""
     cdef const coord_t* base = x + lo
-    cdef intp_t n = hi - lo, half
-    if n == 0:
-        return lo
-    while n > 1:
+    cdef intp_t n = hi - lo, half, i, below = 0
+    while n > LINEAR_RUN:
         half = n >> 1
         base = base + half if base[half] < v else base
         n -= half
-    return (base - x) + (base[0] < v)
+    for i in range(n):
+        below += base[i] < v
+    return (base - x) + below
 
 
 cnp.import_array()
