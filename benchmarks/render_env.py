@@ -1,10 +1,11 @@
 """Render ObjectWorld frames to PNG for the README (docs/img/).
 
 The same world (the first reference world whose view holds all four object types after 10
-steps of the greedy heuristic), drawn whole and as the agent's local view; plus the local views of the minimap and arrow treasure
-variants. Colours: money gold discs, walls grey squares, grass green triangles, enemies
-red diamonds, minimap money cells red rings, the treasure's cell a blue diamond, the arrow
-a purple cross; the agent is the black disc, its view the dark blue square.
+steps of the greedy heuristic), drawn whole and as the agent's local view; plus the minimap
+world and the local views of the minimap and arrow treasure variants. Colours: money gold
+discs, walls grey squares, grass green triangles, enemies red diamonds, minimap money cells red
+rings, the treasure's cell a blue diamond, the arrow a purple cross; the agent is the black
+disc, its view the dark blue square.
 
     python benchmarks/render_env.py [--out docs/img]
 """

@@ -165,7 +165,8 @@ class _Engine:
             near = (objects * objects).sum(axis=2) < clearance2
             for i in np.flatnonzero(near.any(axis=1)):
                 while near[i].any():
-                    objects[i, near[i]] = (2 * size_w) * rngs[i].random((near[i].sum(), 2)) - size_w
+                    redraw = rngs[i].random((near[i].sum(), 2))
+                    objects[i, near[i]] = (2 * size_w) * redraw - size_w
                     near[i] = (objects[i] * objects[i]).sum(axis=1) < clearance2
             random_types = self._random_types
             enemies = objects[:, self._n_random:]

@@ -66,8 +66,9 @@ class _Canvas:
         r0, c0 = self._pixel(x - half, y + half)
         r1, c1 = self._pixel(x + half, y - half)
         size = self.image.shape[0]
-        for rows, cols in (((r0, r0 + width), (c0, c1 + 1)), ((r1 - width + 1, r1 + 1), (c0, c1 + 1)),
-                           ((r0, r1 + 1), (c0, c0 + width)), ((r0, r1 + 1), (c1 - width + 1, c1 + 1))):
+        edges = (((r0, r0 + width), (c0, c1 + 1)), ((r1 - width + 1, r1 + 1), (c0, c1 + 1)),
+                 ((r0, r1 + 1), (c0, c0 + width)), ((r0, r1 + 1), (c1 - width + 1, c1 + 1)))
+        for rows, cols in edges:
             ra, rb = np.clip(rows, 0, size)
             ca, cb = np.clip(cols, 0, size)
             self.image[ra:rb, ca:cb] = colour

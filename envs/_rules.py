@@ -182,7 +182,8 @@ class WorldRules:
             "contact_radius", self.contact_radius, 0.5, checked["view_size"])
         checked["enemy_speed"] = _check_float("enemy_speed", self.enemy_speed, 0.0)
         checked["move_noise"] = _check_float("move_noise", self.move_noise, 0.0, 0.5)
-        checked["swipe_size"] = _check_float("swipe_size", self.swipe_size, 0.0, low_inclusive=False)
+        checked["swipe_size"] = _check_float("swipe_size", self.swipe_size, 0.0,
+                                             low_inclusive=False)
         half = checked["size_w"]
         checked["start_clearance"] = _check_float(
             "start_clearance", self.start_clearance, checked["contact_radius"], half / 2)

@@ -55,7 +55,8 @@ class GreedyPolicy:
         state : None
         """
         if hasattr(observation, "data") and hasattr(observation, "offsets"):
-            return self._actions(np.asarray(observation.data), np.asarray(observation.offsets)), None
+            actions = self._actions(np.asarray(observation.data), np.asarray(observation.offsets))
+            return actions, None
         rows = np.asarray(observation, dtype=np.float32).reshape(-1, 3)
         return self._actions(rows, np.array([0, len(rows)]))[0], None
 
@@ -73,14 +74,16 @@ class GreedyPolicy:
             scores[:, a] = np.bincount(world, weights=value, minlength=n)
             along = np.clip(xy @ step, 0.0, 1.0)
             gap = xy - along[:, None] * step
-            wall = (types == WALL) & ((gap ** 2).sum(axis=1) <= (rules.contact_radius + 0.1) ** 2)
+            reach = rules.contact_radius + rules.move_noise  # margin for the noise
+            wall = (types == WALL) & ((gap ** 2).sum(axis=1) <= reach ** 2)
             scores[np.bincount(world[wall], minlength=n) > 0, a] -= 1e9
         if rules.sword:
             half, size = rules.swipe_size / 2, rules.swipe_size
             for a, (dx, dy) in enumerate(_DIRECTIONS, start=4):
                 along = xy[:, 0] * dx + xy[:, 1] * dy
                 across = xy[:, 0] * dy - xy[:, 1] * dx
-                inside = (types == ENEMY) & (along > 0) & (along <= size) & (np.abs(across) <= half)
+                inside = (types == ENEMY) & (along > 0) & (along <= size)
+                inside &= np.abs(across) <= half
                 lone = np.bincount(world[inside], minlength=n) == 1
                 scores[:, a] = np.where(lone, 1e6, -1e12)
         return scores.argmax(axis=1)

@@ -16,7 +16,11 @@ VARIANTS = [
 ]
 
 
-@pytest.mark.parametrize("rules", VARIANTS, ids=lambda r: ",".join(f"{k}={v}" for k, v in r.items()) or "default")
+def _variant_id(rules):
+    return ",".join(f"{k}={v}" for k, v in rules.items()) or "default"
+
+
+@pytest.mark.parametrize("rules", VARIANTS, ids=_variant_id)
 def test_batched_equals_single_step_by_step(rules):
     n, seeds = 6, [11, 12, 13, 14, 15, 10**12]
     worlds = envs.BatchedObjectWorld(n, **rules)
