@@ -8,7 +8,8 @@ Importing this package registers
   through ``view="local" | "global" | "minimap" | "arrow"``.
 
 Every rule constant is a keyword argument (see `WorldRules`), e.g.
-``gymnasium.make("ObjectWorldTreasure-v0", view="arrow", enemy_speed=0)``.
+``gymnasium.make("ObjectWorldTreasure-v0", view="arrow", enemy_speed=0)``;
+``gymnasium.make_vec(id, num_envs=400)`` builds a `BatchedObjectWorld`.
 """
 from gymnasium.envs.registration import register
 
@@ -28,7 +29,8 @@ __all__ = [
     "TYPE_NAMES", "ACTION_NAMES", "VIEWS",
 ]
 
-_ENTRY_POINT = "envs.object_world:ObjectWorldEnv"
-register(id="ObjectWorld-v0", entry_point=_ENTRY_POINT)
-register(id="ObjectWorldSword-v0", entry_point=_ENTRY_POINT, kwargs={"sword": True})
-register(id="ObjectWorldTreasure-v0", entry_point=_ENTRY_POINT, kwargs={"treasure": True})
+_ENTRY_POINTS = {"entry_point": "envs.object_world:ObjectWorldEnv",
+                 "vector_entry_point": "envs.batched:_make_vec"}
+register(id="ObjectWorld-v0", **_ENTRY_POINTS)
+register(id="ObjectWorldSword-v0", kwargs={"sword": True}, **_ENTRY_POINTS)
+register(id="ObjectWorldTreasure-v0", kwargs={"treasure": True}, **_ENTRY_POINTS)

@@ -91,6 +91,11 @@ def _world_seeds(seed, n):
     return [int(s) for s in seeds]
 
 
+def _make_vec(num_envs, **rules):
+    """Vector entry point of the registered ids: ``gymnasium.make_vec(id, num_envs)``."""
+    return BatchedObjectWorld(num_envs, **rules)
+
+
 class BatchedObjectWorld(VectorEnv):
     """`n_worlds` ObjectWorlds stepped together by one vectorised numpy engine.
 

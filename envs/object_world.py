@@ -9,7 +9,7 @@ from ._rules import WorldRules
 
 __all__ = ["ObjectWorldEnv"]
 
-RENDER_VIEWS = ("world", "local")
+_RENDER_VIEWS = ("world", "local")
 
 
 def _object_space(rules):
@@ -104,9 +104,9 @@ class ObjectWorldEnv(gym.Env):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r}; expected None or "
                              f"one of {self.metadata['render_modes']}")
-        if render_view not in RENDER_VIEWS:
+        if render_view not in _RENDER_VIEWS:
             raise ValueError(f"unknown render_view {render_view!r}; expected one of "
-                             f"{RENDER_VIEWS}")
+                             f"{_RENDER_VIEWS}")
         self.render_mode = render_mode
         self.render_view = render_view
         self.action_space = spaces.Discrete(self.rules.n_actions)

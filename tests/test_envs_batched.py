@@ -49,6 +49,15 @@ def test_batched_equals_single_step_by_step(rules):
     assert n_steps == 150
 
 
+def test_make_vec_builds_the_batched_engine():
+    worlds = gym.make_vec("ObjectWorldSword-v0", num_envs=3, n_enemies=5)
+    assert isinstance(worlds, envs.BatchedObjectWorld) and worlds.num_envs == 3
+    assert worlds.rules.sword and worlds.rules.n_enemies == 5
+    obs, _ = worlds.reset(seed=0)
+    np.testing.assert_array_equal(obs[2], gym.make("ObjectWorldSword-v0", n_enemies=5)
+                                  .reset(seed=2)[0])
+
+
 def test_int_seed_gives_world_i_seed_plus_i():
     worlds = envs.BatchedObjectWorld(3)
     obs, _ = worlds.reset(seed=40)
