@@ -1,4 +1,6 @@
 """The ObjectWorld rules, the gymnasium API, rendering, wrappers and bad input."""
+import doctest
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -321,6 +323,12 @@ def test_greedy_policy_beats_random_play():
     single = envs.ObjectWorldEnv(sword=True)
     obs, _ = single.reset(seed=100)
     assert policy.predict(obs)[0] == policy.predict(worlds.reset(seed=100)[0])[0][0]
+
+
+@pytest.mark.parametrize("module", [envs.object_world, envs.batched, envs.wrappers,
+                                    envs.policies])
+def test_docstring_examples_run(module):
+    assert doctest.testmod(module).failed == 0
 
 
 # --------------------------------------------------------------------------- bad input
