@@ -2,6 +2,8 @@
 import gymnasium as gym
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import envs
 
@@ -178,3 +180,43 @@ def test_ragged_batch_validates():
         envs.RaggedBatch(np.zeros((2, 3)), [0, 3])
     with pytest.raises(TypeError, match="ints"):
         envs.RaggedBatch(np.zeros((2, 3)), [0, 2])[0.5]
+
+
+# --------------------------------------------------------------------------- random rules
+@settings(max_examples=30, deadline=None)
+@given(data=st.data())
+def test_batched_equals_single_for_random_rules(data):
+    treasure = data.draw(st.booleans())
+    rules = {
+        "sword": data.draw(st.booleans()),
+        "treasure": treasure,
+        "view": data.draw(st.sampled_from(envs.VIEWS if treasure else ("local", "global"))),
+        "size_w": data.draw(st.floats(6.0, 40.0)),
+        "n_money": data.draw(st.integers(0, 60)),
+        "n_walls": data.draw(st.integers(0, 60)),
+        "n_grass": data.draw(st.integers(0, 20)),
+        "n_enemies": data.draw(st.integers(0, 40)),
+        "enemy_speed": data.draw(st.floats(0.0, 1.5)),
+        "contact_radius": data.draw(st.floats(0.5, 1.5)),
+        "view_size": data.draw(st.floats(2.0, 12.0)),
+        "max_steps": data.draw(st.integers(1, 12)),
+        "n_treasure": data.draw(st.integers(0, 25)),
+    }
+    n = data.draw(st.integers(1, 4))
+    seed = data.draw(st.integers(0, 2**32))
+    worlds = envs.BatchedObjectWorld(n, **rules)
+    singles = [envs.ObjectWorldEnv(**rules) for _ in range(n)]
+    obs, _ = worlds.reset(seed=seed)
+    expected = [env.reset(seed=seed + i)[0] for i, env in enumerate(singles)]
+    actions = np.random.default_rng(seed).integers(worlds.rules.n_actions,
+                                                   size=(rules["max_steps"], n))
+    for batch in actions:
+        for i in range(n):
+            np.testing.assert_array_equal(obs[i], expected[i])
+            assert worlds.single_observation_space.contains(obs[i])
+        obs, rewards, _, truncated, _ = worlds.step(batch)
+        for i, env in enumerate(singles):
+            expected[i], reward, _, trunc, _ = env.step(batch[i])
+            assert (rewards[i], truncated[i]) == (reward, trunc)
+        assert (np.abs(worlds._engine.agent) < rules["size_w"]).all()  # the border holds
+    assert truncated.all()
