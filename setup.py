@@ -26,7 +26,7 @@ def _extension(name):
 
 setup(
     ext_modules=cythonize(
-        [_extension("_builder"), _extension("_predictor")],
+        [_extension(name) for name in ("_builder", "_predictor", "_rows")],
         compiler_directives={
             "language_level": 3,
             "boundscheck": False,

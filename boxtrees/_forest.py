@@ -10,7 +10,8 @@ from sklearn.utils.validation import _check_sample_weight, check_is_fitted
 
 from ._builder import TEST_KINDS, build_tree
 from ._objects import ObjectInputMixin, check_view_bounds
-from ._predictor import apply_leaves, group_by_type, predict_mean
+from ._predictor import apply_leaves, predict_mean
+from ._rows import group_by_type
 from ._tree import BoxTree, PackedForest
 
 __all__ = ["BoxExtraTreesRegressor"]

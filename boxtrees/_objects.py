@@ -9,6 +9,8 @@ from numbers import Integral
 import numpy as np
 from scipy.sparse import issparse
 
+from ._rows import RowProblem, scan_rows
+
 __all__ = ["ObjectSets"]
 
 _MAX_TYPE = 2**24  # float32 holds every integer type id below this exactly
@@ -22,13 +24,20 @@ def _offsets_from_sizes(sizes):
     return offsets
 
 
+_ROW_PROBLEMS = {
+    RowProblem.ROW_NOT_FINITE: "contain NaN or infinite values",
+    RowProblem.ROW_TOO_LARGE: "have coordinates too large for float32 (|value| > 3.4e38)",
+    RowProblem.ROW_NEGATIVE_TYPE: "have negative type ids; type ids must be integers >= 0",
+    RowProblem.ROW_NON_INTEGER_TYPE: "have non-integer type ids; type ids must be integers >= 0",
+    RowProblem.ROW_TYPE_TOO_LARGE: f"have type ids >= {_MAX_TYPE}, which are not supported",
+}
+
+
 def _check_rows(data, what="object sets"):
     """Validate object rows and return them as a C-contiguous float32 ``(n, 3)`` array."""
     data = np.asarray(data)
-    if data.dtype == object or not (np.issubdtype(data.dtype, np.number) or data.dtype == bool):
-        raise TypeError(f"{what} must hold numbers, got an array of dtype {data.dtype}")
-    if np.iscomplexobj(data):
-        raise TypeError(f"{what} must hold real numbers, got complex values")
+    if data.dtype.kind not in "biuf":
+        raise TypeError(f"{what} must hold real numbers, got an array of dtype {data.dtype}")
     if data.size == 0:
         return np.empty((0, 3), dtype=np.float32)
     if data.ndim != 2 or data.shape[1] != 3:
@@ -36,19 +45,13 @@ def _check_rows(data, what="object sets"):
             f"{what} must be arrays of shape (n_objects, 3) with columns [x, y, type]; "
             f"got shape {data.shape}"
         )
-    if not np.isfinite(data).all():
-        raise ValueError(f"{what} contain NaN or infinite values")
-    if np.abs(data[:, :2]).max() > _FLOAT32_MAX:
-        raise ValueError(f"{what} have coordinates too large for float32 (|value| > 3.4e38)")
-    types = data[:, 2]
-    if types.min() < 0:
-        raise ValueError(f"{what} have negative type ids; type ids must be integers >= 0")
-    if not np.issubdtype(types.dtype, np.integer):
-        if (types != np.floor(types)).any():
-            raise ValueError(f"{what} have non-integer type ids; type ids must be integers >= 0")
-    if types.max() >= _MAX_TYPE:
-        raise ValueError(f"{what} have type ids >= {_MAX_TYPE}, which are not supported")
-    return np.ascontiguousarray(data, dtype=np.float32)
+    if data.dtype != np.float32:
+        data = data.astype(np.float64, copy=False)
+    data = np.ascontiguousarray(data)
+    problem, row = scan_rows(data, _FLOAT32_MAX, _MAX_TYPE)
+    if problem != RowProblem.ROW_OK:
+        raise ValueError(f"{what} {_ROW_PROBLEMS[problem]} (object row {row}: {data[row].tolist()})")
+    return data.astype(np.float32, copy=False)
 
 
 class ObjectSets:

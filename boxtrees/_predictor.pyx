@@ -1,8 +1,10 @@
 """Forest traversal: predictions and leaf indices for batches of object sets.
 
-Before traversal the objects of each sample are grouped by type, so a node test scans only the
-sample's objects of the tested type (and stops as soon as the threshold is reached). Samples are
-processed in blocks, tree by tree, so that a tree's nodes stay in cache across a block.
+The objects of each sample come grouped by type (``boxtrees._rows.group_by_type``), so a node
+test scans only the sample's objects of the tested type (and stops as soon as the threshold is reached). A node's
+test is one 32-byte record (half a cache line) and a left child follows its parent, so a
+root-to-leaf walk touches few cache lines. Samples are processed in blocks, tree by tree, so
+that a tree's nodes stay in cache across a block.
 """
 import numpy as np
 
@@ -12,12 +14,16 @@ cdef enum:
     BLOCK = 64
 
 
+cdef packed struct PackedNode:   # the layout of boxtrees._tree.NODE_DTYPE
+    int32 left                   # tree-local child ids
+    int32 right
+    int32 object_type
+    int32 threshold
+    coord_t box[4]
+
+
 cdef struct ForestView:
-    const intp_t* left           # tree-local child indices
-    const intp_t* right
-    const int32* object_type
-    const coord_t* box           # 4 bounds per node
-    const int32* threshold
+    const PackedNode* nodes
     const intp_t* tree_offsets   # first node of each tree in the packed arrays
 
 
@@ -28,78 +34,33 @@ cdef struct SampleView:
     intp_t stride                # n_types + 1
 
 
-def group_by_type(const coord_t[:, ::1] data, const intp_t[::1] offsets, intp_t n_types):
-    """Regroup each set's objects by type, dropping types ``>= n_types``.
-
-    Returns ``x, y`` of shape (n_kept,) and ``type_ptr`` of shape (n_sets, n_types + 1):
-    the objects of type ``t`` of set ``i`` are ``type_ptr[i, t]:type_ptr[i, t + 1]``.
-    """
-    cdef intp_t n_sets = offsets.shape[0] - 1, i, k, t, pos = 0
-    type_ptr_arr = np.zeros((n_sets, n_types + 1), dtype=np.intp)
-    cdef intp_t[:, ::1] type_ptr = type_ptr_arr
-    cdef intp_t[::1] cursor = np.empty(n_types + 1, dtype=np.intp)
-    with nogil:
-        for i in range(n_sets):
-            for k in range(offsets[i], offsets[i + 1]):
-                t = <intp_t>data[k, 2]
-                if t < n_types:
-                    type_ptr[i, t + 1] += 1
-            type_ptr[i, 0] = pos
-            for t in range(n_types):
-                pos += type_ptr[i, t + 1]
-                type_ptr[i, t + 1] = pos
-    x_arr = np.empty(pos, dtype=np.float32)
-    y_arr = np.empty(pos, dtype=np.float32)
-    cdef coord_t[::1] x = x_arr, y = y_arr
-    with nogil:
-        for i in range(n_sets):
-            for t in range(n_types):
-                cursor[t] = type_ptr[i, t]
-            for k in range(offsets[i], offsets[i + 1]):
-                t = <intp_t>data[k, 2]
-                if t < n_types:
-                    x[cursor[t]] = data[k, 0]
-                    y[cursor[t]] = data[k, 1]
-                    cursor[t] += 1
-    return x_arr, y_arr, type_ptr_arr
-
-
 cdef inline intp_t _find_leaf(const ForestView* f, const SampleView* s, intp_t tree,
                               intp_t i) noexcept nogil:
     """Tree-local index of the leaf that sample ``i`` reaches in ``tree``."""
-    cdef intp_t root = f.tree_offsets[tree], node = 0, g, k, k_end
-    cdef const coord_t* b
-    cdef int32 count, z
-    while f.left[root + node] != TREE_LEAF:
-        g = root + node
-        b = f.box + 4 * g
-        z = f.threshold[g]
-        k = s.type_ptr[i * s.stride + f.object_type[g]]
-        k_end = s.type_ptr[i * s.stride + f.object_type[g] + 1]
+    cdef const PackedNode* nodes = f.nodes + f.tree_offsets[tree]
+    cdef const PackedNode* n = nodes
+    cdef const intp_t* types = s.type_ptr + i * s.stride
+    cdef intp_t k, k_end
+    cdef int32 count
+    while n.left != TREE_LEAF:
+        k = types[n.object_type]
+        k_end = types[n.object_type + 1]
         count = 0
-        while k < k_end and count < z:
-            if s.x[k] > b[0] and s.x[k] < b[1] and s.y[k] > b[2] and s.y[k] < b[3]:
+        while k < k_end and count < n.threshold:
+            if s.x[k] > n.box[0] and s.x[k] < n.box[1] and s.y[k] > n.box[2] and s.y[k] < n.box[3]:
                 count += 1
             k += 1
-        node = f.left[g] if count < z else f.right[g]
-    return node
+        n = nodes + (n.left if count < n.threshold else n.right)
+    return n - nodes
 
 
 cdef inline void _views(ForestView* f, SampleView* s, forest, samples):
-    cdef const intp_t[::1] left = forest.children_left
-    cdef const intp_t[::1] right = forest.children_right
-    cdef const int32[::1] object_type = forest.object_type
-    cdef const coord_t[:, ::1] box = forest.box
-    cdef const int32[::1] threshold = forest.threshold
+    cdef const PackedNode[::1] nodes = forest.nodes
     cdef const intp_t[::1] tree_offsets = forest.tree_offsets
     cdef const coord_t[::1] x = samples[0]
     cdef const coord_t[::1] y = samples[1]
     cdef const intp_t[:, ::1] type_ptr = samples[2]
-    f.left = &left[0]
-    f.right = &right[0]
-    f.object_type = &object_type[0]
-    f.box = &box[0, 0]
-    f.threshold = &threshold[0]
+    f.nodes = &nodes[0]
     f.tree_offsets = &tree_offsets[0]
     # an empty batch of objects still needs valid pointers; nothing is read through them
     s.x = &x[0] if x.shape[0] else NULL

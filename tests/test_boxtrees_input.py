@@ -27,7 +27,7 @@ def small_forest(**params):
         ([np.zeros((2, 3)), np.zeros(3)], [1.0, 2.0], ValueError, r"set 1 has shape \(3,\)"),
         ([np.zeros((2, 3, 1))], [1.0], ValueError, "shape"),
         (np.zeros((4, 2, 2)), np.ones(4), ValueError, r"\(n_samples, n_objects, 3\)"),
-        ([np.array([["a", "b", "c"]])], [1.0], TypeError, "must hold numbers"),
+        ([np.array([["a", "b", "c"]])], [1.0], TypeError, "must hold real numbers"),
         ([np.array([[1e39, 0.0, 0]])], [1.0], ValueError, "too large for float32"),
         (GOOD, [1.0, 2.0], ValueError, "3 samples but y has 2"),
         (GOOD, [1.0, np.nan, 2.0], ValueError, "NaN"),
