@@ -250,11 +250,12 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
     def _traverse(self, X, kernel, out):
         """Validate ``X`` and run a traversal kernel over its samples, in parallel chunks
         when the batch is large."""
-        check_is_fitted(self)
+        if "estimators_" not in self.__dict__:  # cheap test first: predict is called per step
+            check_is_fitted(self)
         sets, _ = self._validate_input(X, reset=False)
         samples = group_by_type(sets.data, sets.offsets, self.n_types_)
-        out = out(len(sets))
         n = len(sets)
+        out = out(n)
         n_jobs = min(effective_n_jobs(self.n_jobs), max(n // (_PARALLEL_PREDICT_MIN_SAMPLES // 2), 1))
         if n_jobs == 1 or n < _PARALLEL_PREDICT_MIN_SAMPLES:
             kernel(self._packed, samples, 0, n, out)

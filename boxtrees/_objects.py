@@ -111,6 +111,11 @@ class ObjectSets:
         -------
         ObjectSets
         """
+        if len(sets) == 1:  # fast path: one set, as when predicting for a single observation
+            data = np.asarray(sets[0])
+            if data.size == 0 or (data.ndim == 2 and data.shape[1] == 3):
+                data = _check_rows(data)
+                return cls._trusted(data, np.array([0, len(data)], dtype=np.intp))
         arrays = []
         for i, s in enumerate(sets):
             a = np.asarray(s)

@@ -1,0 +1,152 @@
+"""Speed and accuracy of BoxExtraTreesRegressor against scikit-learn's ExtraTreesRegressor.
+
+Workloads (thesis parameters K=500, n_min=30, M=30):
+- object sets (~16 objects per sample, 4 types, target = box counts): our forest with fixed
+  TW=1 boxes and with random boxes, vs sklearn ET on GridCounts(10) features;
+- a dense 10,000 x 20 regression: our forest on the feature matrix (classic tests, K = number
+  of features) vs sklearn ET with max_features=all, same trees and n_min;
+- single-sample predict latency of a 30-tree forest.
+
+Prints a table, writes ``bench_trees.json`` and ``bench_trees.png`` under ``--out``.
+
+    python benchmarks/bench_trees.py [--quick] [--out results] [--n-jobs 2]
+"""
+import argparse
+import json
+import os
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+from sklearn.datasets import make_friedman1
+from sklearn.ensemble import ExtraTreesRegressor
+from sklearn.metrics import r2_score
+
+from boxtrees import BoxExtraTreesRegressor, GridCounts, make_box_regression
+
+M, K, N_MIN = 30, 500, 30
+
+
+def timed(fn, repeat=1):
+    """Best wall time of ``repeat`` calls, and the last result."""
+    best = np.inf
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = fn()
+        best = min(best, time.perf_counter() - start)
+    return best, result
+
+
+def run_model(name, model, X, y, X_test, y_test):
+    fit_s, _ = timed(lambda: model.fit(X, y))
+    predict_s, pred = timed(lambda: model.predict(X_test))
+    row = {"model": name, "n_samples": len(y), "fit_s": fit_s, "predict_s": predict_s,
+           "r2": r2_score(y_test, pred)}
+    print(f"  {name:<34} n={len(y):>6}  fit {fit_s:7.2f} s  predict {predict_s:6.3f} s  R2 {row['r2']:.3f}")
+    return row
+
+
+def object_set_workload(n_samples, n_jobs, seed=0):
+    X, y = make_box_regression(n_samples, random_state=seed)
+    X_test, y_test = make_box_regression(5000, random_state=seed + 1)
+    rows = []
+    for test_type in ("fixed", "random"):
+        forest = BoxExtraTreesRegressor(M, n_tests=K, min_samples_split=N_MIN, test_type=test_type,
+                                        test_width=1.0, n_jobs=n_jobs, random_state=seed)
+        rows.append(run_model(f"box forest ({test_type})", forest, X, y, X_test, y_test))
+    grid = GridCounts(10).fit(X)
+    et = ExtraTreesRegressor(M, min_samples_split=N_MIN, max_features=1.0, n_jobs=n_jobs, random_state=seed)
+    rows.append(run_model("sklearn ET on GridCounts(10)", et, grid.transform(X), y,
+                          grid.transform(X_test), y_test))
+    return rows, forest
+
+
+def dense_workload(n_jobs, seed=0):
+    X, y = make_friedman1(15000, n_features=20, noise=1.0, random_state=seed)
+    X, X_test, y, y_test = X[:10000], X[10000:], y[:10000], y[10000:]
+    ours = BoxExtraTreesRegressor(M, n_tests=X.shape[1], min_samples_split=N_MIN, test_type="classic",
+                                  n_jobs=n_jobs, random_state=seed)
+    et = ExtraTreesRegressor(M, min_samples_split=N_MIN, max_features=1.0, n_jobs=n_jobs, random_state=seed)
+    return [run_model("box forest (classic) on matrix", ours, X, y, X_test, y_test),
+            run_model("sklearn ET on matrix", et, X, y, X_test, y_test)]
+
+
+def single_sample_latency(forest, n_calls=2000):
+    X, _ = make_box_regression(n_calls, random_state=99)
+    samples = [[X[i]] for i in range(n_calls)]
+    forest.set_params(n_jobs=1)
+    forest.predict(samples[0])
+    times = []
+    for s in samples:
+        start = time.perf_counter()
+        forest.predict(s)
+        times.append(time.perf_counter() - start)
+    return float(np.median(times) * 1e6)
+
+
+def plot(rows, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = [f"{r['model']}\n(n={r['n_samples']})" for r in rows]
+    fig, axes = plt.subplots(1, 2, figsize=(12, 0.55 * len(rows) + 1.5), sharey=True)
+    colours = ["tab:blue" if r["model"].startswith("box") else "tab:grey" for r in rows]
+    axes[0].barh(labels, [r["fit_s"] for r in rows], color=colours)
+    axes[0].set_xlabel("fit time (s)")
+    axes[1].barh(labels, [r["r2"] for r in rows], color=colours)
+    axes[1].set_xlabel("held-out $R^2$")
+    axes[0].invert_yaxis()
+    fig.suptitle("BoxExtraTreesRegressor vs scikit-learn ExtraTreesRegressor (30 trees, n_min=30)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="only N=5,000 object sets")
+    parser.add_argument("--out", default="results", help="output folder")
+    parser.add_argument("--n-jobs", type=int, default=2)
+    args = parser.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+
+    sizes = [5000] if args.quick else [5000, 20000]
+    rows = []
+    for n in sizes:
+        print(f"object sets, N={n}:")
+        workload_rows, forest = object_set_workload(n, args.n_jobs)
+        rows += workload_rows
+    print("dense 10,000 x 20 (Friedman #1):")
+    rows += dense_workload(args.n_jobs)
+    latency_us = single_sample_latency(forest)
+    print(f"single-sample predict, 30 trees: {latency_us:.1f} us (median)")
+
+    def ratio(model_a, model_b, n, key="fit_s"):
+        a = next(r for r in rows if r["model"] == model_a and r["n_samples"] == n)
+        b = next(r for r in rows if r["model"] == model_b and r["n_samples"] == n)
+        return b[key] / a[key]
+
+    n_big = sizes[-1]
+    summary = {
+        "object_fit_speedup_vs_sklearn_grid": ratio("box forest (fixed)", "sklearn ET on GridCounts(10)", n_big),
+        "object_fit_speedup_n": n_big,
+        "dense_fit_speedup_vs_sklearn": ratio("box forest (classic) on matrix", "sklearn ET on matrix", 10000),
+        "single_sample_predict_us": latency_us,
+    }
+    print(f"\nobject-set fit speed-up vs sklearn-on-grid at N={n_big}: "
+          f"{summary['object_fit_speedup_vs_sklearn_grid']:.1f}x (target >= 5x at N=20,000)")
+    print(f"dense fit speed-up vs sklearn: {summary['dense_fit_speedup_vs_sklearn']:.2f}x (target >= 1x)")
+    print(f"single-sample predict: {latency_us:.1f} us (target <= 50 us)")
+    report = {"rows": rows, "summary": summary, "n_jobs": args.n_jobs, "cpu_count": os.cpu_count(),
+              "machine": platform.machine(), "python": platform.python_version()}
+    (out / "bench_trees.json").write_text(json.dumps(report, indent=2))
+    plot(rows, out / "bench_trees.png")
+    print(f"wrote {out / 'bench_trees.json'} and {out / 'bench_trees.png'}")
+
+
+if __name__ == "__main__":
+    main()
