@@ -1,7 +1,7 @@
 """Forest traversal: predictions and leaf indices for batches of object sets.
 
 The objects of each sample come grouped by type (``boxtrees._rows.group_by_type``), so a node
-test scans only the sample's objects of the tested type (and stops as soon as the threshold is reached). A node's
+test scans only the sample's objects of the tested type. A node's
 test is one 32-byte record (half a cache line) and a left child follows its parent, so a
 root-to-leaf walk touches few cache lines. Samples are processed in blocks, tree by tree, so
 that a tree's nodes stay in cache across a block.
@@ -46,9 +46,9 @@ cdef inline intp_t _find_leaf(const ForestView* f, const SampleView* s, intp_t t
         k = types[n.object_type]
         k_end = types[n.object_type + 1]
         count = 0
-        while k < k_end and count < n.threshold:
-            if s.x[k] > n.box[0] and s.x[k] < n.box[1] and s.y[k] > n.box[2] and s.y[k] < n.box[3]:
-                count += 1
+        while k < k_end:                # branch-free: a sample has few objects of a type
+            count += ((s.x[k] > n.box[0]) & (s.x[k] < n.box[1])
+                      & (s.y[k] > n.box[2]) & (s.y[k] < n.box[3]))
             k += 1
         n = nodes + (n.left if count < n.threshold else n.right)
     return n - nodes
