@@ -2,10 +2,12 @@
 import dataclasses
 import time
 import warnings
+from concurrent.futures import ThreadPoolExecutor
 from numbers import Integral, Real
 
 import joblib
 import numpy as np
+from joblib import effective_n_jobs
 from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 from tqdm.auto import tqdm
@@ -80,6 +82,9 @@ class FQI:
     eval_steps : int, default=20_000
         Steps of the greedy evaluation after each iteration (a multiple of the episode
         length, 50); 0 skips the evaluation (``reward`` is then NaN).
+    n_jobs : int, default=-1
+        Threads predicting the per-action Q-functions concurrently (at most one per
+        action; -1: one per core). The box forests release the GIL while predicting.
     log_path : str or path-like, default=None
         CSV file receiving one row per iteration (see `history` for the columns).
     seed : int or None, default=None
@@ -117,7 +122,7 @@ class FQI:
 
     def __init__(self, regressor, env, gamma=0.8, epsilon=0.2, samples_per_iteration=20_000,
                  resample_every=1, keep_data=False, max_samples=100_000, n_worlds=400,
-                 eval_steps=20_000, log_path=None, seed=None, verbose=0):
+                 eval_steps=20_000, n_jobs=-1, log_path=None, seed=None, verbose=0):
         for method in ("fit", "predict"):
             if not callable(getattr(regressor, method, None)):
                 raise TypeError(f"regressor must have fit and predict methods; "
@@ -143,6 +148,9 @@ class FQI:
         if self.eval_steps % self.rules.max_steps:
             raise ValueError(f"eval_steps must be a multiple of the episode length "
                              f"{self.rules.max_steps}; got {self.eval_steps}")
+        if not isinstance(n_jobs, Integral) or isinstance(n_jobs, bool) or n_jobs == 0:
+            raise ValueError(f"n_jobs must be a non-zero int, got {n_jobs!r}")
+        self.n_jobs = int(n_jobs)
         if seed is not None:
             _check_int("seed", seed, 0)
         self.seed = seed
@@ -154,6 +162,7 @@ class FQI:
         self._action_rng = np.random.default_rng(action_seq)
         self._fit_rng = np.random.default_rng(fit_seq)
         self._collector = None
+        self._pool = None
         self._data = None
         self.q_functions_ = None
         self.history = []
@@ -200,7 +209,9 @@ class FQI:
         collect_reward = np.nan
         if self._data is None or (self.resample_every is not None
                                   and self.iteration % self.resample_every == 0):
-            batch = self._collector.collect(self.samples_per_iteration, self._behaviour)
+            batch = self._collector.collect(
+                self.samples_per_iteration, self._behaviour,
+                None if self.q_functions_ is None else self._q_values)
             self.num_timesteps += -(-self.samples_per_iteration // self.n_worlds) * self.n_worlds
             new, collect_reward = len(batch), float(batch.rewards.mean())
             if self.keep_data and self._data is not None:
@@ -211,8 +222,11 @@ class FQI:
 
         targets = data.rewards.copy()
         if self.q_functions_ is not None:
-            future = self._q_values(data.next_states).max(axis=1)
+            future = data.next_values  # known when the data was just collected with Q_{n-1}
+            if future is None:
+                future = self._q_values(data.next_states).max(axis=1)
             targets += self.gamma * np.where(data.terminated, 0.0, future)
+        data.next_values = None  # stale once Q_n is fitted
         targeted = time.perf_counter()
 
         self.q_functions_ = [self._fit_action(a, data, targets) for a in range(self.n_actions)]
@@ -240,11 +254,12 @@ class FQI:
                   f"evaluate {record['t_evaluate']:5.2f}s")
         return record
 
-    def _behaviour(self, obs):
-        """Collection policy: uniform random before the first fit, then epsilon-greedy."""
-        if self.q_functions_ is None:
+    def _behaviour(self, obs, q):
+        """Collection policy: uniform random before the first fit (``q`` is None), then
+        epsilon-greedy on the Q-values ``q`` of the observations."""
+        if q is None:
             return self._action_rng.integers(self.n_actions, size=len(obs))
-        return self._epsilon_greedy(self._q_values(obs))
+        return self._epsilon_greedy(q)
 
     def _epsilon_greedy(self, q):
         n = len(q)
@@ -289,8 +304,10 @@ class FQI:
     def _q_values(self, sets):
         if self.q_functions_ is None:
             raise NotFittedError("this FQI agent has no Q-function yet; call learn() first")
-        return np.column_stack([np.asarray(m.predict(sets), dtype=np.float64)
-                                for m in self.q_functions_])
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(min(effective_n_jobs(self.n_jobs), self.n_actions))
+        predictions = self._pool.map(lambda model: model.predict(sets), self.q_functions_)
+        return np.column_stack([np.asarray(p, dtype=np.float64) for p in predictions])
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         """Actions for one observation or a batch (the stable-baselines3 signature).
@@ -329,7 +346,7 @@ class FQI:
         """
         params = {name: getattr(self, name) for name in (
             "regressor", "gamma", "epsilon", "samples_per_iteration", "resample_every",
-            "keep_data", "max_samples", "n_worlds", "eval_steps", "seed", "verbose")}
+            "keep_data", "max_samples", "n_worlds", "eval_steps", "n_jobs", "seed", "verbose")}
         joblib.dump({
             "format": _SAVE_FORMAT, "params": params, "rules": dataclasses.asdict(self.rules),
             "q_functions_": self.q_functions_, "history": self.history,
@@ -368,6 +385,11 @@ class FQI:
         agent.iteration = state["iteration"]
         agent._world_rng, agent._action_rng, agent._fit_rng = state["rngs"]
         return agent
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_pool"] = None  # threads do not pickle; a new pool starts on demand
+        return state
 
     def __repr__(self):
         return (f"FQI(regressor={self.regressor!r}, gamma={self.gamma}, "

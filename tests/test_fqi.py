@@ -1,0 +1,347 @@
+"""The FQI agent: SB3-style API, data regimes, determinism, persistence, learning, bad input."""
+import csv
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from sklearn.base import BaseEstimator, RegressorMixin
+from sklearn.exceptions import NotFittedError
+
+import envs
+from boxtrees import BoxExtraTreesRegressor, ObjectSets
+from fqi import (FQI, GridObservation, RandomPolicy, evaluate, make_box_forest,
+                 make_grid_ridge, train_dqn)
+from fqi._collect import _Collector, _Transitions
+
+ENV = "ObjectWorld-v0"
+
+
+def small_forest(**params):
+    return BoxExtraTreesRegressor(n_estimators=5, n_tests=50, view_bounds=10, n_jobs=1,
+                                  **params)
+
+
+def small_agent(regressor=None, **params):
+    settings = dict(samples_per_iteration=1000, n_worlds=50, eval_steps=500, seed=0)
+    settings.update(params)
+    return FQI(small_forest() if regressor is None else regressor, ENV, **settings)
+
+
+class ObjectCountQ(RegressorMixin, BaseEstimator):
+    """Q(s) = weight * (number of objects in s); records what it was fitted on."""
+
+    def __init__(self, weight=1.0):
+        self.weight = weight
+
+    def fit(self, X, y):
+        self.X_, self.y_ = X, np.asarray(y)
+        return self
+
+    def predict(self, X):
+        return self.weight * ObjectSets(X.data, X.offsets).sizes.astype(float)
+
+
+@pytest.fixture(scope="module")
+def trained():
+    return small_agent().learn(2)
+
+
+# ---------------------------------------------------------------- SB3 shape
+def test_evaluate_policy_from_stable_baselines3(trained):
+    from stable_baselines3.common.evaluation import evaluate_policy
+
+    env = envs.PaddedObjects(gym.make(ENV), max_objects=128)
+    with pytest.warns(UserWarning, match="Monitor"):
+        mean, std = evaluate_policy(trained, env, n_eval_episodes=2)
+    assert np.isfinite(mean) and np.isfinite(std)
+
+
+def test_predict_accepts_every_observation_form(trained):
+    worlds = envs.BatchedObjectWorld(6)
+    obs, _ = worlds.reset(seed=3)
+    batch, _ = trained.predict(obs)
+    assert batch.shape == (6,) and batch.dtype.kind == "i"
+    assert [trained.predict(o)[0] for o in obs] == batch.tolist()  # one (n, 3) each
+    assert trained.predict(list(obs))[0].tolist() == batch.tolist()
+    single = envs.PaddedObjects(gym.make(ENV), 128)
+    padded = np.stack([single.observation(o) for o in obs])
+    assert trained.predict(padded)[0].tolist() == batch.tolist()
+    assert trained.predict(padded[2])[0] == batch[2]
+    assert trained.q_values(obs).shape == (6, 4) and trained.q_values(obs[0]).shape == (4,)
+    assert trained.predict(np.empty((0, 3)))[0] in range(4)
+    # epsilon-greedy when not deterministic: epsilon=1 gives some non-greedy actions
+    trained.epsilon = 1.0
+    try:
+        explored, _ = trained.predict(np.tile(padded, (20, 1, 1)), deterministic=False)
+    finally:
+        trained.epsilon = 0.2
+    assert (explored != np.tile(batch, 20)).any()
+
+
+def test_callback_sees_every_iteration_and_can_stop():
+    seen = []
+
+    def plain(locals_, globals_):
+        seen.append(locals_["record"]["iteration"])
+        assert locals_["self"].iteration == len(seen)
+        return len(seen) < 2  # stop after the second iteration
+
+    agent = small_agent(eval_steps=0).learn(5, callback=plain)
+    assert seen == [0, 1] and agent.iteration == 2
+
+    class Watcher:
+        def __init__(self):
+            self.rewards = []
+
+        def on_iteration(self, agent, record):
+            self.rewards.append(record["reward"])
+
+    watcher = Watcher()
+    agent = small_agent().learn(3, callback=watcher)
+    assert watcher.rewards == [r["reward"] for r in agent.history] and len(watcher.rewards) == 3
+
+
+def test_progress_bar_and_verbose(capsys):
+    small_agent(eval_steps=0, verbose=1).learn(2, progress_bar=True)
+    captured = capsys.readouterr()
+    assert "FQI" in captured.err and "2/2" in captured.err  # tqdm writes to stderr
+    assert captured.out.count("iteration") == 2
+
+
+def test_csv_log_has_one_row_per_iteration(tmp_path):
+    path = tmp_path / "log.csv"
+    agent = small_agent(log_path=path).learn(2)
+    agent.learn(1)  # appends, one header
+    with path.open() as f:
+        rows = list(csv.DictReader(f))
+    assert [int(r["iteration"]) for r in rows] == [0, 1, 2]
+    for key in ("reward", "t_collect", "t_targets", "t_fit", "t_evaluate", "n_samples",
+                "nodes_per_tree"):
+        assert float(rows[-1][key]) == pytest.approx(agent.history[-1][key])
+    assert float(rows[1]["nodes_per_tree"]) > 1
+
+
+# ---------------------------------------------------------------- persistence and seeds
+def test_save_load_round_trip(trained, tmp_path):
+    trained.save(tmp_path / "agent.joblib")
+    loaded = FQI.load(tmp_path / "agent.joblib")
+    worlds = envs.BatchedObjectWorld(50)
+    obs, _ = worlds.reset(seed=envs.reference_worlds(50))
+    np.testing.assert_array_equal(loaded.predict(obs)[0], trained.predict(obs)[0])
+    np.testing.assert_array_equal(loaded.q_values(obs), trained.q_values(obs))
+    assert loaded.history == trained.history and loaded.iteration == 2
+    assert loaded.gamma == trained.gamma and loaded.rules == trained.rules
+    loaded.learn(1)  # training continues on fresh data
+    assert loaded.iteration == 3 and loaded.num_timesteps == 3000
+
+
+def test_same_seed_same_reward_curve():
+    def curve(seed):
+        return [r["reward"] for r in small_agent(seed=seed).learn(3).history]
+
+    first = curve(7)
+    assert curve(7) == first
+    assert curve(8) != first
+
+
+def test_training_never_sees_reference_worlds():
+    seeds = []
+    collector = _Collector(envs.WorldRules(), 20, np.random.default_rng(0))
+    reset = collector.env.reset
+
+    def spy(*, seed=None, options=None):
+        seeds.append(seed)
+        return reset(seed=seed, options=options)
+
+    collector.env.reset = spy
+    collector.collect(2000, lambda obs, q: np.zeros(len(obs), dtype=int))
+    assert seeds[1:] == [None, None]  # 2 episodes, then each world continues its generator
+    assert len(seeds[0]) == 20 and max(seeds[0]) < envs.REFERENCE_SEED_START
+
+
+# ---------------------------------------------------------------- algorithm
+def test_collection_reuses_q_values_as_next_state_values():
+    q = ObjectCountQ().predict
+    collector = _Collector(envs.WorldRules(max_steps=7), 30, np.random.default_rng(0))
+
+    def q_values(sets):
+        base = q(sets)
+        return np.column_stack([base, -base, 2 * base, np.zeros_like(base)])
+
+    def policy(obs, values):
+        return values.argmax(axis=1) % 4
+
+    data = collector.collect(30 * 10 + 5, policy, q_values)  # crosses an episode end
+    assert len(data) == 305
+    np.testing.assert_array_equal(data.next_values, q_values(data.next_states).max(axis=1))
+    np.testing.assert_array_equal(data.states[30:60].data, data.next_states[:30].data)
+
+
+def test_targets_bootstrap_through_truncation_but_not_termination():
+    agent = small_agent(ObjectCountQ(weight=2.0), gamma=0.5, resample_every=None)
+    agent.learn(1)
+    first = agent.q_functions_
+    np.testing.assert_array_equal(
+        np.concatenate([m.y_ for m in first]),
+        np.concatenate([agent._data.rewards[agent._data.actions == a] for a in range(4)]))
+    # every episode here ends by truncation: all targets bootstrap
+    data = agent._data
+    agent.learn(1)
+    expected = data.rewards + 0.5 * 2.0 * data.next_states.sizes
+    for a, model in enumerate(agent.q_functions_):
+        np.testing.assert_allclose(model.y_, expected[data.actions == a])
+    # a (synthetic) termination cuts the bootstrap
+    data.terminated[::3] = True
+    agent.learn(1)
+    expected = data.rewards + np.where(data.terminated, 0.0, data.next_states.sizes)
+    for a, model in enumerate(agent.q_functions_):
+        np.testing.assert_allclose(model.y_, expected[data.actions == a])
+
+
+def test_regimes_collect_when_they_should():
+    def new_samples(**params):
+        agent = small_agent(eval_steps=0, **params).learn(7)
+        return [r["new_samples"] for r in agent.history], [r["n_samples"] for r in agent.history]
+
+    assert new_samples(resample_every=1) == ([1000] * 7, [1000] * 7)
+    assert new_samples(resample_every=None) == ([1000] + [0] * 6, [1000] * 7)
+    assert new_samples(resample_every=5) == ([1000, 0, 0, 0, 0, 1000, 0], [1000] * 7)
+    kept = new_samples(keep_data=True, max_samples=2500)
+    assert kept == ([1000] * 7, [1000, 2000, 2500, 2500, 2500, 2500, 2500])
+
+
+def test_missing_action_keeps_its_previous_q_function():
+    agent = small_agent(ObjectCountQ(), epsilon=0.0, eval_steps=0).learn(1)
+    # a greedy agent on an object count picks the same action everywhere
+    with pytest.warns(RuntimeWarning, match="no transition with action"):
+        agent.learn(1)
+
+
+def test_box_fqi_and_grid_ridge_beat_random():
+    """Thesis 3.2 at small scale: 3 iterations of 5,000 samples on ObjectWorld-v0, scored
+    on the 400 reference worlds (20,000 steps) against the random policy."""
+    random_score = evaluate(RandomPolicy(ENV, seed=0), ENV)
+    scores = {}
+    for name, regressor in [("box", make_box_forest(ENV, n_estimators=10, random_state=0)),
+                            ("grid", make_grid_ridge(ENV))]:
+        agent = FQI(regressor, ENV, samples_per_iteration=5000, eval_steps=0, seed=0)
+        scores[name] = evaluate(agent.learn(3), ENV)
+    assert random_score < -80_000
+    assert scores["box"] > random_score + 120_000, scores
+    assert scores["grid"] > random_score + 50_000, scores
+
+
+# ---------------------------------------------------------------- baselines
+def test_grid_observation_reuses_grid_counts():
+    from stable_baselines3.common.env_checker import check_env
+
+    env = GridObservation(gym.make(ENV), n_bins=10)
+    check_env(env, warn=True)
+    raw = gym.make(ENV)
+    obs, _ = env.reset(seed=4)
+    objects, _ = raw.reset(seed=4)
+    assert obs.shape == (400,) and obs.dtype == np.float32
+    np.testing.assert_array_equal(obs, env.grid.transform([objects])[0])
+    assert obs.sum() == np.sum(np.abs(objects[:, :2]).max(axis=1) <= 10)
+    assert GridObservation(gym.make("ObjectWorldSword-v0")).action_space.n == 8
+
+
+def test_train_dqn_scores_with_the_same_evaluation():
+    result = train_dqn(ENV, total_timesteps=300, eval_steps=500, seed=0, learning_starts=100,
+                       policy_kwargs={"net_arch": [16]})
+    assert result.model.num_timesteps == 300 and result.total_timesteps == 300
+    assert np.isfinite(result.reward) and result.train_seconds > 0
+    assert result.reward == evaluate(result.policy, ENV, 500)
+
+
+def test_scripted_policies_use_the_same_evaluation():
+    assert evaluate(envs.GreedyPolicy(envs.BatchedObjectWorld(1)), ENV) > 100_000
+    assert evaluate(RandomPolicy(ENV, seed=1), ENV, 1000) < 0
+
+
+# ---------------------------------------------------------------- bad input
+class NoPredict(BaseEstimator):
+    def fit(self, X, y):
+        return self
+
+
+@pytest.mark.parametrize("regressor, match", [
+    (NoPredict(), "has no predict"), ("forest", "fit and predict"), (None, "fit and predict")])
+def test_regressor_without_fit_predict(regressor, match):
+    with pytest.raises(TypeError, match=match):
+        FQI(regressor, ENV)
+
+
+def test_env_needs_discrete_actions_and_object_world():
+    with pytest.raises(TypeError, match="Discrete action space"):
+        FQI(small_forest(), gym.make("Pendulum-v1"))
+    with pytest.raises(TypeError, match="Discrete action space"):
+        GridObservation(gym.make("Pendulum-v1"))
+    with pytest.raises(TypeError, match="ObjectWorld env"):
+        FQI(small_forest(), gym.make("CartPole-v1"))
+    with pytest.raises(TypeError, match="env must be"):
+        FQI(small_forest(), 42)
+
+
+@pytest.mark.parametrize("params, error, match", [
+    ({"epsilon": -0.1}, ValueError, r"epsilon must lie in \[0.0, 1.0\]"),
+    ({"epsilon": 1.5}, ValueError, "epsilon"),
+    ({"epsilon": float("nan")}, ValueError, "epsilon"),
+    ({"epsilon": "0.2"}, TypeError, "epsilon must be a number"),
+    ({"samples_per_iteration": 0}, ValueError, "samples_per_iteration must be >= 1"),
+    ({"samples_per_iteration": 2.5}, TypeError, "samples_per_iteration must be an int"),
+    ({"gamma": 1.0}, ValueError, "gamma"),
+    ({"resample_every": 0}, ValueError, "resample_every"),
+    ({"keep_data": True, "max_samples": 10}, ValueError, "max_samples"),
+    ({"eval_steps": 120}, ValueError, "multiple of the episode length"),
+    ({"n_worlds": 0}, ValueError, "n_worlds"),
+    ({"n_jobs": 0}, ValueError, "n_jobs"),
+])
+def test_bad_parameters(params, error, match):
+    with pytest.raises(error, match=match):
+        small_agent(**params)
+
+
+@pytest.mark.parametrize("observation, error, match", [
+    (np.zeros((5, 2)), ValueError, r"\(n, 3\) array"),
+    (np.zeros(3), ValueError, r"got shape \(3,\)"),
+    (np.zeros((2, 5, 6)), ValueError, "padded"),
+    (np.array([[0.0, 1.0, np.nan]]), ValueError, "NaN"),
+    (np.array([[0.0, 1.0, -1.0]]), ValueError, "negative type"),
+    ([np.zeros((2, 2))], ValueError, r"shape \(n_objects, 3\)"),
+    (np.array([["a", "b", "c"]]), TypeError, "numbers"),
+])
+def test_predict_rejects_bad_observations(trained, observation, error, match):
+    with pytest.raises(error, match=match):
+        trained.predict(observation)
+
+
+def test_predict_before_learn_and_bad_learn_arguments(tmp_path):
+    agent = small_agent()
+    with pytest.raises(NotFittedError, match="learn"):
+        agent.predict(np.zeros((1, 3)))
+    with pytest.raises(ValueError, match="n_iterations"):
+        agent.learn(0)
+    with pytest.raises(TypeError, match="callback"):
+        agent.learn(1, callback=3)
+    path = tmp_path / "other.joblib"
+    import joblib
+    joblib.dump({"something": 1}, path)
+    with pytest.raises(ValueError, match="not an FQI agent"):
+        FQI.load(path)
+
+
+def test_evaluate_rejects_bad_step_counts():
+    with pytest.raises(ValueError, match="multiple of the episode length 50"):
+        evaluate(RandomPolicy(ENV), ENV, 1234)
+    with pytest.raises(ValueError, match="positive multiple"):
+        evaluate(RandomPolicy(ENV), ENV, 0)
+
+
+def test_transitions_concatenate_drops_unknown_next_values():
+    sets = ObjectSets.from_sequence([np.zeros((1, 3))] * 2)
+    known = _Transitions(sets, np.zeros(2, int), np.zeros(2), sets, np.zeros(2, bool),
+                         np.ones(2))
+    unknown = _Transitions(sets, np.zeros(2, int), np.zeros(2), sets, np.zeros(2, bool))
+    assert _Transitions.concatenate([known, known]).next_values.tolist() == [1, 1, 1, 1]
+    assert _Transitions.concatenate([known, unknown]).next_values is None
