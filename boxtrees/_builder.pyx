@@ -121,6 +121,9 @@ cdef class _Splitter:
     cdef intp_t* hi
     cdef const float64_t* target
     cdef const float64_t* weight
+    cdef float64_t* weighted_target  # weight * target
+    cdef double* region              # per type of the current node: x0, x1, y0, y1 of its tests
+    cdef intp_t* type_size           # per type: the current node's number of objects
     cdef const float64_t* edges      # band edges, n_bands + 1, from -inf to +inf
     cdef const coord_t[:, ::1] bounds
     cdef intp_t n_samples
@@ -154,6 +157,9 @@ cdef class _Splitter:
             np.ascontiguousarray(target, dtype=np.float64),
             np.ascontiguousarray(weight, dtype=np.float64),
             np.ascontiguousarray(band_edges, dtype=np.float64),
+            np.asarray(weight, dtype=np.float64) * np.asarray(target, dtype=np.float64),
+            np.empty(4 * bounds.shape[0], dtype=np.float64),
+            np.empty(bounds.shape[0], dtype=np.intp),
         ]
         self._keep_alive = arrays
         self.xs = <coord_t*>_data(arrays[0])
@@ -172,6 +178,9 @@ cdef class _Splitter:
         self.target = <const float64_t*>_data(arrays[13])
         self.weight = <const float64_t*>_data(arrays[14])
         self.edges = <const float64_t*>_data(arrays[15])
+        self.weighted_target = <float64_t*>_data(arrays[16])
+        self.region = <double*>_data(arrays[17])
+        self.type_size = <intp_t*>_data(arrays[18])
         self.bounds = bounds
         self.n_samples = n_samples
         self.n_types = bounds.shape[0]
@@ -183,25 +192,39 @@ cdef class _Splitter:
         self.max_retries = max_retries
         self.rng = seed
 
+    cdef void start_node(self, intp_t start, intp_t end, double w_sum, double wy_sum) noexcept nogil:
+        """Make samples ``start:end`` (and the segment ranges ``lo:hi``) the node to split."""
+        cdef intp_t ty, g
+        cdef double* r
+        self.start = start
+        self.end = end
+        self.w_sum = w_sum
+        self.wy_sum = wy_sum
+        for ty in range(self.n_types):
+            r = self.region + 4 * ty
+            r[0] = self.bounds[ty, 0]
+            r[1] = self.bounds[ty, 1]
+            r[2] = self.bounds[ty, 2]
+            r[3] = self.bounds[ty, 3]
+            self.type_size[ty] = 0
+            if self.local_x:
+                r[0], r[1] = INFINITY, -INFINITY
+            for g in range(ty * self.n_bands, (ty + 1) * self.n_bands):
+                self.type_size[ty] += self.hi[g] - self.lo[g]
+                if self.local_x and self.hi[g] > self.lo[g]:
+                    r[0] = min(r[0], self.xs[self.lo[g]])
+                    r[1] = max(r[1], self.xs[self.hi[g] - 1])
+
     cdef bint sample_test(self, BoxTest* t) noexcept nogil:
         """Draw a test; False when its type has no object in the node (it cannot split)."""
         cdef intp_t ty = rand_int(&self.rng, self.n_types)
-        cdef double x0 = self.bounds[ty, 0], x1 = self.bounds[ty, 1]
-        cdef double y0 = self.bounds[ty, 2], y1 = self.bounds[ty, 3]
+        cdef const double* r = self.region + 4 * ty
+        cdef double x0 = r[0], x1 = r[1], y0 = r[2], y1 = r[3]
         cdef bint one_dim = y0 == -INFINITY     # feature-matrix columns: the y extent is unbounded
         cdef double a, b, h
-        cdef intp_t g, n_objects = 0
         t.object_type = ty
-        for g in range(ty * self.n_bands, (ty + 1) * self.n_bands):
-            n_objects += self.hi[g] - self.lo[g]
-        if n_objects == 0:
+        if self.type_size[ty] == 0:
             return False
-        if self.local_x:
-            x0, x1 = INFINITY, -INFINITY
-            for g in range(ty * self.n_bands, (ty + 1) * self.n_bands):
-                if self.hi[g] > self.lo[g]:
-                    x0 = min(x0, self.xs[self.lo[g]])
-                    x1 = max(x1, self.xs[self.hi[g] - 1])
         t.ymin = -INFINITY
         t.ymax = INFINITY
         if self.kind == RANDOM:
@@ -232,11 +255,11 @@ cdef class _Splitter:
                 t.ymin, t.ymax = a - h, a + h
         return True
 
-    cdef intp_t count(self, const BoxTest* t) noexcept nogil:
+    cdef intp_t count(self, const BoxTest* t, int32* cmax) noexcept nogil:
         """Count, per node sample, its objects of the test's type strictly inside the box.
 
-        Returns the number of samples hit; their ids are ``hits[:n]`` and their counts sit in
-        ``counts`` (the caller resets them).
+        Returns the number of samples hit; their ids are ``hits[:n]``, their counts sit in
+        ``counts`` (the caller resets them) and the largest count in ``cmax``.
         """
         cdef const coord_t* xs = self.xs
         cdef const coord_t* ys = self.ys
@@ -248,7 +271,7 @@ cdef class _Splitter:
         cdef const float64_t* edges = self.edges
         cdef coord_t ymin = t.ymin, ymax = t.ymax
         cdef intp_t band, g, a, e, j, n, n_hit = 0
-        cdef int32 s
+        cdef int32 s, c, top = 0
         for band in range(self.n_bands):
             if edges[band + 1] <= ymin or edges[band] >= ymax:
                 continue
@@ -267,41 +290,47 @@ cdef class _Splitter:
                 inside = strip
             for j in range(n):
                 s = inside[j]
+                c = counts[s]
                 hits[n_hit] = s
-                n_hit += counts[s] == 0
-                counts[s] += 1
+                n_hit += c == 0
+                counts[s] = c + 1
+                top = max(top, c + 1)
+        cmax[0] = top
         return n_hit
 
     cdef bint evaluate(self, BoxTest* t) noexcept nogil:
         """Draw the threshold of a test and score it; False if its counts are constant."""
-        cdef intp_t n_hit = self.count(t)
+        cdef int32 cmax, cmin = 0, c
+        cdef intp_t n_hit = self.count(t, &cmax)
         cdef int32* counts = self.counts
         cdef const int32* hits = self.hits
         cdef intp_t j
-        cdef int32 s, c, cmin = INT_MAX, cmax = 0
-        cdef double wr = 0.0, wyr = 0.0, wl, wyl
-        cdef bint valid
-        for j in range(n_hit):
-            c = counts[hits[j]]
-            cmin = min(cmin, c)
-            cmax = max(cmax, c)
-        if n_hit < self.end - self.start:
-            cmin = 0                           # a sample the box missed counts zero
-        valid = n_hit > 0 and cmax > cmin
-        if valid:
-            t.threshold = cmin + 1 + <int32>rand_int(&self.rng, cmax - cmin)
+        cdef int32 s
+        cdef double wr = 0.0, wyr = 0.0, wl, wyl, right
+        if n_hit == 0:
+            return False
+        if n_hit == self.end - self.start:     # else a sample the box missed counts zero
+            cmin = cmax
             for j in range(n_hit):
-                s = hits[j]
-                if counts[s] >= t.threshold:
-                    wr += self.weight[s]
-                    wyr += self.weight[s] * self.target[s]
-            wl = self.w_sum - wr
-            wyl = self.wy_sum - wyr
-            valid = wl > 0.0 and wr > 0.0
-            t.proxy = wyl * wyl / wl + wyr * wyr / wr if valid else -INFINITY
-        for j in range(n_hit):
-            counts[hits[j]] = 0
-        return valid
+                cmin = min(cmin, counts[hits[j]])
+        if cmax == cmin:
+            for j in range(n_hit):
+                counts[hits[j]] = 0
+            return False
+        t.threshold = cmin + 1 + <int32>rand_int(&self.rng, cmax - cmin)
+        for j in range(n_hit):                 # right-child sums, resetting the counts
+            s = hits[j]
+            c = counts[s]
+            counts[s] = 0
+            right = c >= t.threshold
+            wr += right * self.weight[s]
+            wyr += right * self.weighted_target[s]
+        wl = self.w_sum - wr
+        wyl = self.wy_sum - wyr
+        if wl <= 0.0 or wr <= 0.0:
+            return False
+        t.proxy = wyl * wyl / wl + wyr * wyr / wr
+        return True
 
     cdef bint find_best(self, BoxTest* best) noexcept nogil:
         """Best of ``n_tests`` random tests, retried up to ``max_retries`` rounds if none splits."""
@@ -324,7 +353,8 @@ cdef class _Splitter:
         Per segment, the left child's objects end up in ``lo[g]:right_lo[g]`` and the right
         child's in ``right_lo[g]:hi[g]``, each still sorted by x.
         """
-        cdef intp_t n_hit = self.count(best)
+        cdef int32 cmax
+        cdef intp_t n_hit = self.count(best, &cmax)
         cdef coord_t* xs = self.xs
         cdef coord_t* ys = self.ys
         cdef int32* sid = self.sid
@@ -425,10 +455,7 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segme
         if (rec.end - rec.start < 2 or w < min_samples_split or ymin == ymax
                 or (max_depth >= 0 and rec.depth >= max_depth)):
             continue
-        splitter.start = rec.start
-        splitter.end = rec.end
-        splitter.w_sum = w
-        splitter.wy_sum = wy
+        splitter.start_node(rec.start, rec.end, w, wy)
         if not splitter.find_best(&best):
             continue
         mid = splitter.split(&best, right_lo.data())

@@ -40,5 +40,5 @@ cdef inline double rand_uniform(uint64* state, double low, double high) noexcept
 
 
 cdef inline intp_t rand_int(uint64* state, intp_t n) noexcept nogil:
-    """Uniform integer in [0, n), n >= 1."""
-    return <intp_t>(rand_u64(state) % <uint64>n)
+    """Uniform integer in [0, n), 1 <= n < 2**32 (multiply-shift: no slow division)."""
+    return <intp_t>(((rand_u64(state) >> 32) * <uint64>n) >> 32)
