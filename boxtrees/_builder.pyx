@@ -27,6 +27,9 @@ from ._utils cimport (
 TEST_KINDS = {"random": RANDOM, "fixed": FIXED, "bounded": BOUNDED, "classic": CLASSIC}
 
 
+cdef double TIE_TOLERANCE = 1e-11
+
+
 cdef struct BoxTest:
     intp_t object_type
     coord_t xmin
@@ -140,6 +143,7 @@ cdef class _Splitter:
     cdef intp_t end
     cdef double w_sum
     cdef double wy_sum
+    cdef double tie                  # proxies closer than this are ties (rounding noise)
 
     def __cinit__(self, x, y, sample_of, target, weight, band_edges,
                   const coord_t[:, ::1] bounds, bint local_x, int kind, double width,
@@ -192,7 +196,8 @@ cdef class _Splitter:
         self.max_retries = max_retries
         self.rng = seed
 
-    cdef void start_node(self, intp_t start, intp_t end, double w_sum, double wy_sum) noexcept nogil:
+    cdef void start_node(self, intp_t start, intp_t end, double w_sum, double wy_sum,
+                         double wy2_sum) noexcept nogil:
         """Make samples ``start:end`` (and the segment ranges ``lo:hi``) the node to split."""
         cdef intp_t ty, g
         cdef double* r
@@ -200,6 +205,10 @@ cdef class _Splitter:
         self.end = end
         self.w_sum = w_sum
         self.wy_sum = wy_sum
+        # A proxy is at most sum(w y^2); differences below this are summation-order noise,
+        # and the test drawn first wins them, so equal data in another order or as repeated
+        # rows instead of integer weights gives the same tree.
+        self.tie = TIE_TOLERANCE * wy2_sum
         for ty in range(self.n_types):
             r = self.region + 4 * ty
             r[0] = self.bounds[ty, 0]
@@ -340,7 +349,8 @@ cdef class _Splitter:
         best.proxy = -INFINITY
         for r in range(self.max_retries + 1):
             for k in range(self.n_tests):
-                if self.sample_test(&t) and self.evaluate(&t) and t.proxy > best.proxy:
+                if (self.sample_test(&t) and self.evaluate(&t)
+                        and (not found or t.proxy > best.proxy + self.tie)):
                     best[0] = t
                     found = True
             if found:
@@ -455,7 +465,7 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segme
         if (rec.end - rec.start < 2 or w < min_samples_split or ymin == ymax
                 or (max_depth >= 0 and rec.depth >= max_depth)):
             continue
-        splitter.start_node(rec.start, rec.end, w, wy)
+        splitter.start_node(rec.start, rec.end, w, wy, wy2)
         if not splitter.find_best(&best):
             continue
         mid = splitter.split(&best, right_lo.data())
