@@ -207,7 +207,7 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         trees = Parallel(n_jobs=self.n_jobs, verbose=self.verbose, prefer="threads")(
             delayed(build_tree)(
                 x_sorted, y_sorted, sample_of, segment_ptr, band_edges, y, sample_weight, self.bounds_,
-                local_x, self.test_type, float(self.test_width), self.n_tests,
+                local_x, self._fitted_on_features, self.test_type, float(self.test_width), self.n_tests,
                 float(self.min_samples_split), max_depth, self.max_retries, int(seed),
             )
             for seed in seeds
