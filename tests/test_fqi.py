@@ -227,8 +227,9 @@ def test_box_fqi_and_grid_ridge_beat_random():
         agent = FQI(regressor, ENV, samples_per_iteration=5000, eval_steps=0, seed=0)
         scores[name] = evaluate(agent.learn(3), ENV)
     assert random_score < -80_000
-    assert scores["box"] > random_score + 120_000, scores
-    assert scores["grid"] > random_score + 50_000, scores
+    # measured (seed 0): box about +40,000, grid about -34,000, random -95,650
+    assert scores["box"] > random_score + 100_000, scores
+    assert scores["grid"] > random_score + 40_000, scores
 
 
 # ---------------------------------------------------------------- baselines
