@@ -1,0 +1,70 @@
+"""Named budgets: how many seeds, iterations, samples and evaluation steps a run gets.
+
+A budget's name is part of every cache path (``<out>/runs/<budget>/...``), so runs of
+different budgets never mix.
+"""
+from dataclasses import dataclass
+
+__all__ = ["Budget", "BUDGETS", "EVAL_REFERENCE_STEPS"]
+
+# Rewards are reported per 20,000 evaluation steps (the thesis's 400 episodes of 50 steps).
+EVAL_REFERENCE_STEPS = 20_000
+
+
+@dataclass(frozen=True)
+class Budget:
+    """Sizes of every unit of work at one level of effort.
+
+    Parameters
+    ----------
+    name : str
+        Folder name under ``<out>/runs/``.
+    seeds : int
+        Runs per setting (seeds ``0 .. seeds - 1``).
+    iterations : int
+        FQI iterations per run.
+    samples : int
+        Transitions collected per FQI iteration (experiments may scale it, e.g. the sword
+        game's 40,000).
+    eval_steps : int
+        Greedy evaluation steps after each iteration (a multiple of 50); rewards are
+        rescaled to 20,000 steps in every table and plot.
+    rmse_samples, rmse_folds : int
+        Random-policy transitions and cross-validation folds of the appendix's RMSE study.
+    dqn_steps : int or None
+        DQN environment steps; None: as many as the FQI run (iterations x samples).
+    attention_iterations : int
+        FQI iterations of the run whose Q-forest the attention figure draws.
+    max_trees, max_tests : int or None
+        Caps on the forests' M and K (None: the thesis's values).
+    """
+
+    name: str
+    seeds: int
+    iterations: int
+    samples: int
+    eval_steps: int
+    rmse_samples: int
+    rmse_folds: int
+    dqn_steps: int = None
+    attention_iterations: int = 3
+    max_trees: int = None
+    max_tests: int = None
+
+    @property
+    def reward_scale(self):
+        """Factor turning an evaluation total into a reward per 20,000 steps."""
+        return EVAL_REFERENCE_STEPS / self.eval_steps
+
+
+BUDGETS = {
+    "full": Budget("full", seeds=5, iterations=20, samples=20_000, eval_steps=20_000,
+                   rmse_samples=20_000, rmse_folds=10, attention_iterations=10),
+    "quick": Budget("quick", seeds=1, iterations=5, samples=5_000, eval_steps=10_000,
+                    rmse_samples=5_000, rmse_folds=3, dqn_steps=25_000,
+                    attention_iterations=3),
+    # for the tests: every experiment end to end in seconds
+    "tiny": Budget("tiny", seeds=1, iterations=1, samples=400, eval_steps=100,
+                   rmse_samples=400, rmse_folds=2, dqn_steps=300, attention_iterations=1, max_trees=2,
+                   max_tests=20),
+}

@@ -1,0 +1,211 @@
+"""Declarative checks of the thesis's claims, evaluated on our measured numbers.
+
+Each rule is a small frozen dataclass with a ``claim`` (the thesis's wording, short) and a
+``check(stats)`` method taking ``{label: SettingStats}`` and returning a `Verdict`. Nothing
+here knows any result in advance: the verdicts come from the numbers only.
+"""
+import math
+from dataclasses import dataclass
+
+__all__ = ["Verdict", "Ranking", "Similar", "MoreStable", "Sign", "NearRandom",
+           "HighestPeak", "Falls"]
+
+# Two scores closer than this many combined standard errors are "within noise".
+_NOISE_SE = 2.0
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Outcome of one rule: ``holds`` is True, False, or None (not enough data)."""
+
+    claim: str
+    holds: object
+    explanation: str
+
+    @property
+    def mark(self):
+        """``yes`` / ``no`` / ``n/a`` for tables."""
+        return {True: "yes", False: "no"}.get(self.holds, "n/a")
+
+
+def _fmt(value):
+    return f"{value:,.0f}" if abs(value) >= 100 else f"{value:,.3g}"
+
+
+def _missing(claim, stats, labels):
+    absent = [label for label in labels if label not in stats]
+    if absent:
+        return Verdict(claim, None, f"not run: {', '.join(absent)}")
+    return None
+
+
+def _better(a, b):
+    """Whether setting stats `a` scores better than `b` (lower RMSE, higher reward)."""
+    return a.score < b.score if a.lower_is_better else a.score > b.score
+
+
+def _gap_note(a, b):
+    """' (within noise)' when the two scores differ by less than `_NOISE_SE` SEs."""
+    se = math.hypot(a.score_se, b.score_se)
+    if math.isnan(se) or abs(a.score - b.score) >= _NOISE_SE * se:
+        return ""
+    return " (within noise)"
+
+
+@dataclass(frozen=True)
+class Ranking:
+    """Every label of group ``i`` scores better than every label of any later group.
+
+    Parameters
+    ----------
+    groups : tuple of tuple of str
+        Best first; labels inside one group are not compared ("~" in the thesis's
+        ordering).
+    claim : str
+    """
+
+    groups: tuple
+    claim: str
+
+    def check(self, stats):
+        labels = [label for group in self.groups for label in group]
+        missing = _missing(self.claim, stats, labels)
+        if missing:
+            return missing
+        wrong, noisy = [], []
+        for i, upper in enumerate(self.groups):
+            for lower in self.groups[i + 1:]:
+                for a in upper:
+                    for b in lower:
+                        note = _gap_note(stats[a], stats[b])
+                        if not _better(stats[a], stats[b]):
+                            wrong.append(f"{b} ({_fmt(stats[b].score)}) >= {a} "
+                                         f"({_fmt(stats[a].score)}){note}")
+                        elif note:
+                            noisy.append(f"{a} vs {b}")
+        order = " > ".join(f"{label} {_fmt(stats[label].score)}" for label in sorted(
+            labels, key=lambda label: stats[label].score,
+            reverse=not stats[labels[0]].lower_is_better))
+        if wrong:
+            return Verdict(self.claim, False, f"measured {order}; out of order: "
+                                              + "; ".join(wrong))
+        tail = f"; holds but within noise for {', '.join(noisy)}" if noisy else ""
+        return Verdict(self.claim, True, f"measured {order}{tail}")
+
+
+@dataclass(frozen=True)
+class Similar:
+    """No setting differs from another by more than `_NOISE_SE` combined SEs."""
+
+    labels: tuple
+    claim: str
+
+    def check(self, stats):
+        missing = _missing(self.claim, stats, self.labels)
+        if missing:
+            return missing
+        items = [stats[label] for label in self.labels]
+        worst = max(((a, b) for a in items for b in items),
+                    key=lambda p: abs(p[0].score - p[1].score) - _NOISE_SE * math.hypot(
+                        p[0].score_se, p[1].score_se))
+        a, b = worst
+        se = math.hypot(a.score_se, b.score_se)
+        spread = ", ".join(f"{s.label} {_fmt(s.score)}" for s in items)
+        if math.isnan(se):
+            return Verdict(self.claim, None, f"measured {spread}; too few values for a noise "
+                                             f"estimate")
+        holds = abs(a.score - b.score) < _NOISE_SE * se
+        return Verdict(self.claim, holds,
+                       f"measured {spread}; largest gap {_fmt(abs(a.score - b.score))} vs "
+                       f"{_NOISE_SE:g} SE = {_fmt(_NOISE_SE * se)}")
+
+
+@dataclass(frozen=True)
+class MoreStable:
+    """`stable` changes less between consecutive iterations than each of `others`."""
+
+    stable: str
+    others: tuple
+    claim: str
+
+    def check(self, stats):
+        missing = _missing(self.claim, stats, (self.stable, *self.others))
+        if missing:
+            return missing
+        values = {label: stats[label].instability for label in (self.stable, *self.others)}
+        if any(math.isnan(v) for v in values.values()):
+            return Verdict(self.claim, None, "needs at least 2 iterations")
+        holds = all(values[self.stable] < values[o] for o in self.others)
+        listed = ", ".join(f"{label} {_fmt(v)}" for label, v in values.items())
+        return Verdict(self.claim, holds, f"mean |change| between iterations: {listed}")
+
+
+@dataclass(frozen=True)
+class Sign:
+    """The score of `label` is positive (``positive=True``) or negative."""
+
+    label: str
+    positive: bool
+    claim: str
+
+    def check(self, stats):
+        missing = _missing(self.claim, stats, (self.label,))
+        if missing:
+            return missing
+        score = stats[self.label].score
+        return Verdict(self.claim, (score > 0) == self.positive,
+                       f"measured {self.label} {_fmt(score)}")
+
+
+@dataclass(frozen=True)
+class NearRandom:
+    """`label` scores closer to the random policy than to `reference`."""
+
+    label: str
+    reference: str
+    claim: str
+
+    def check(self, stats):
+        missing = _missing(self.claim, stats, (self.label, self.reference))
+        if missing:
+            return missing
+        s, ref = stats[self.label], stats[self.reference]
+        holds = abs(s.score - s.random_reward) < abs(ref.score - s.score)
+        return Verdict(self.claim, holds,
+                       f"{self.label} {_fmt(s.score)}, random policy {_fmt(s.random_reward)}, "
+                       f"{self.reference} {_fmt(ref.score)}")
+
+
+@dataclass(frozen=True)
+class HighestPeak:
+    """`label` reaches the best single evaluation among `labels`."""
+
+    label: str
+    labels: tuple
+    claim: str
+
+    def check(self, stats):
+        missing = _missing(self.claim, stats, self.labels)
+        if missing:
+            return missing
+        winner = max(self.labels, key=lambda label: stats[label].best)
+        listed = ", ".join(f"{label} {_fmt(stats[label].best)}" for label in self.labels)
+        return Verdict(self.claim, winner == self.label, f"best single evaluation: {listed}")
+
+
+@dataclass(frozen=True)
+class Falls:
+    """The score improves from the first to the last of `labels` (e.g. RMSE falls as M
+    grows)."""
+
+    labels: tuple
+    claim: str
+
+    def check(self, stats):
+        missing = _missing(self.claim, stats, self.labels)
+        if missing:
+            return missing
+        first, last = stats[self.labels[0]], stats[self.labels[-1]]
+        listed = ", ".join(f"{label} {_fmt(stats[label].score)}" for label in self.labels)
+        return Verdict(self.claim, _better(last, first),
+                       f"measured {listed}{_gap_note(first, last)}")

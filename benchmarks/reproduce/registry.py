@@ -1,0 +1,237 @@
+"""The experiment registry: every reproduced figure of the thesis, and the extras, as data.
+
+One `Experiment` per figure. Its ``settings`` map a curve / bar label to the parameters of
+one unit of work (see `reproduce.units`); ``defaults`` hold the parameters its settings
+share. A setting ``{"same_as": "experiment/label"}`` reuses another experiment's runs
+instead of repeating them. ``findings`` are the thesis's claims as rules
+(`reproduce.findings`) checked on our numbers; ``thesis`` holds the thesis's numbers shown
+beside ours.
+"""
+from dataclasses import dataclass, field
+
+from .findings import (Falls, HighestPeak, MoreStable, NearRandom, Ranking, Sign,
+                       Similar)
+
+__all__ = ["Experiment", "EXPERIMENTS", "REGISTRY", "resolve"]
+
+# Thesis 3.1: "standard parameter settings n_min = 30, K = 300 and M = 15". Which box
+# sampling 3.1-3.3 used is not stated; we use the final fixed boxes (TW=1).
+_STANDARD = {"model": "box", "test_type": "fixed", "test_width": 1.0, "n_estimators": 15,
+             "n_tests": 300, "min_samples_split": 30}
+# Thesis 3.2 on: the tuned K = 500, M = 30, n_min = 30.
+_TUNED = {**_STANDARD, "n_estimators": 30, "n_tests": 500}
+_REPRESENTATIONS = {
+    "fixed TW=1": {"test_type": "fixed", "test_width": 1.0},
+    "bounded TW=4": {"test_type": "bounded", "test_width": 4.0},
+    "random box": {"test_type": "random"},
+    "grid 10 + ridge": {"model": "grid", "n_bins": 10},
+    "classic": {"test_type": "classic"},
+}
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One figure: its settings, the thesis's numbers and claims.
+
+    Parameters
+    ----------
+    name : str
+        Identifier (``--only``, folder names).
+    figure : str
+        The thesis's figure ("3.6", "A.1"), or "extra".
+    title : str
+    kind : {"fqi", "rmse", "dqn", "attention"}
+        Default unit kind of the settings (a setting may set its own ``kind``).
+    settings : dict of str to dict
+        Label -> parameters (merged over `defaults`), in plotting order.
+    defaults : dict
+    env_id : str
+    sample_scale : float
+        Multiplies the budget's samples per iteration (2 for the sword game's 40,000).
+    thesis : dict of str to str
+        Label -> the thesis's number or statement for it.
+    findings : tuple of rules
+    notes : str
+        Choices where the thesis is silent, for the report.
+    """
+
+    name: str
+    figure: str
+    title: str
+    kind: str
+    settings: dict
+    defaults: dict = field(default_factory=dict)
+    env_id: str = "ObjectWorld-v0"
+    sample_scale: float = 1.0
+    thesis: dict = field(default_factory=dict)
+    findings: tuple = ()
+    notes: str = ""
+
+    def params(self, label):
+        """Full parameters of a setting (defaults, env and kind filled in)."""
+        params = {"kind": self.kind, "env_id": self.env_id, **self.defaults,
+                  **self.settings[label]}
+        return params
+
+
+def _axis(name, figure, title, key, values, label, base, **kwargs):
+    """An experiment varying one parameter `key` over `values` (labels ``label(v)``)."""
+    settings = {label(v): {key: v} for v in values}
+    return Experiment(name, figure, title, defaults=base, settings=settings, **kwargs)
+
+
+_RMSE = {"kind": "rmse"}
+EXPERIMENTS = (
+    # ---------------------------------------------------------------- appendix A: RMSE
+    _axis("rmse_K", "A.1", "RMSE vs number of tests K", "n_tests", (50, 100, 300, 500),
+          lambda v: f"K={v}", _STANDARD, **_RMSE,
+          thesis={"K=300": "lowest RMSE"},
+          findings=(Ranking((("K=300",), ("K=50", "K=100", "K=500")),
+                            "K=300 gives the lowest RMSE"),)),
+    _axis("rmse_nmin", "A.2", "RMSE vs minimum node size n_min", "min_samples_split",
+          (5, 10, 20, 30, 50), lambda v: f"n_min={v}", _STANDARD, **_RMSE,
+          thesis={"n_min=20": "lowest (15-25 best)"},
+          findings=(Ranking((("n_min=20",), ("n_min=5", "n_min=10", "n_min=30", "n_min=50")),
+                            "n_min between 15 and 25 gives the lowest RMSE"),)),
+    _axis("rmse_M", "A.3", "RMSE vs number of trees M", "n_estimators", (5, 10, 15, 30),
+          lambda v: f"M={v}", _STANDARD, **_RMSE,
+          thesis={"M=30": "lowest (falls with M; M=10 surprisingly low)"},
+          findings=(Falls(("M=5", "M=10", "M=15", "M=30"), "RMSE falls as M grows"),)),
+    _axis("rmse_TW", "A.4", "RMSE vs test width TW (fixed boxes)", "test_width",
+          (1.0, 2.5, 4.0), lambda v: f"TW={v:g}", _STANDARD, **_RMSE,
+          thesis={"TW=2.5": "lowest RMSE"},
+          findings=(Ranking((("TW=2.5",), ("TW=1", "TW=4")), "TW=2.5 gives the lowest RMSE"),)),
+    _axis("rmse_grid", "A.5", "RMSE vs grid size N (grid + ridge)", "n_bins", (5, 10, 16, 21),
+          lambda v: f"N={v}", {"model": "grid"}, **_RMSE,
+          thesis={"N=16": "lowest RMSE"},
+          findings=(Ranking((("N=16",), ("N=5", "N=10", "N=21")), "N=16 gives the lowest RMSE"),)),
+    # ---------------------------------------------------------------- 3.1: parameters
+    _axis("fqi_nmin", "3.1", "FQI reward vs n_min", "min_samples_split", (10, 20, 30),
+          lambda v: f"n_min={v}", _STANDARD, kind="fqi",
+          thesis={"n_min=30": "no significant difference between 10, 20, 30"},
+          findings=(Similar(("n_min=10", "n_min=20", "n_min=30"),
+                            "no significant difference between n_min 10, 20, 30"),)),
+    _axis("fqi_K", "3.2", "FQI reward vs number of tests K", "n_tests", (50, 300, 500),
+          lambda v: f"K={v}", _STANDARD, kind="fqi",
+          thesis={"K=50": "worst", "K=500": "best, stable early"},
+          findings=(Ranking((("K=300", "K=500"), ("K=50",)), "K=50 is the worst"),)),
+    _axis("fqi_M", "3.3", "FQI reward vs number of trees M", "n_estimators", (5, 15, 30),
+          lambda v: f"M={v}", _STANDARD, kind="fqi",
+          thesis={"M=30": "highest (more trees, higher reward)"},
+          findings=(Ranking((("M=30",), ("M=15",), ("M=5",)),
+                            "more trees converge to a higher reward"),)),
+    Experiment(
+        "fqi_TW", "3.4", "FQI reward vs test width (fixed and bounded boxes)", "fqi",
+        defaults=_STANDARD,
+        settings={f"{kind} TW={w:g}": {"test_type": kind, "test_width": w}
+                  for kind in ("fixed", "bounded") for w in (1.0, 2.5, 4.0)},
+        thesis={"fixed TW=1": "best fixed (converges higher than 2.5)",
+                "fixed TW=4": "too big: bad", "bounded TW=4": "most stable, highest peak"},
+        findings=(Ranking((("fixed TW=1",), ("fixed TW=2.5",), ("fixed TW=4",)),
+                          "fixed boxes: TW=1 > 2.5 > 4"),
+                  HighestPeak("bounded TW=4", ("bounded TW=1", "bounded TW=2.5",
+                                               "bounded TW=4"),
+                              "bounded boxes: TW=4 reaches the highest reward"))),
+    _axis("fqi_grid", "3.5", "FQI reward vs grid size N (grid + ridge)", "n_bins", (10, 15, 21),
+          lambda v: f"N={v}", {"model": "grid"}, kind="fqi",
+          thesis={"N=10": "best", "N=21": "worst"},
+          findings=(Ranking((("N=10",), ("N=15",), ("N=21",)), "grid 10 > 15 > 21"),)),
+    # ---------------------------------------------------------------- 3.2: representations
+    Experiment(
+        "representations", "3.6", "State representations (4 actions)", "fqi",
+        defaults=_TUNED, settings=_REPRESENTATIONS,
+        thesis={"fixed TW=1": "about 100,000 (best run 120,000)",
+                "bounded TW=4": "about 100,000 (similar to fixed)",
+                "random box": "about 70,000", "grid 10 + ridge": "about 20,000",
+                "classic": "worst, never reliably positive", "random policy": "about -100,000"},
+        findings=(Ranking((("fixed TW=1", "bounded TW=4"), ("random box",),
+                           ("grid 10 + ridge",), ("classic",)),
+                          "fixed ~ bounded > random box > grid > classic"),
+                  Sign("grid 10 + ridge", True, "grid + ridge reaches a positive reward"))),
+    Experiment(
+        "treasure", "3.8", "Treasure game: local view vs global information", "fqi",
+        env_id="ObjectWorldTreasure-v0",
+        defaults={**_TUNED, "test_type": "random"},
+        settings={view: {"view": view} for view in ("local", "arrow", "minimap", "global")},
+        thesis={"local": "best", "arrow": "slightly worse than local",
+                "minimap": "slightly worse than local", "global": "near random"},
+        findings=(Ranking((("local",), ("arrow", "minimap"), ("global",)),
+                          "local view > arrow, minimap > global view"),
+                  NearRandom("global", "local", "global view stays near the random policy")),
+        notes="Random boxes, K=500, M=30, n_min=30 (the thesis's 'N = 30' read as n_min)."),
+    Experiment(
+        "sampling", "3.9", "Data regimes: normal vs mixed (re-sample every 5)", "fqi",
+        defaults=_TUNED,
+        settings={"normal": {"resample_every": 1}, "mixed (every 5)": {"resample_every": 5}},
+        thesis={"mixed (every 5)": "more stable, higher mean",
+                "normal": "less stable; best single policy"},
+        findings=(Ranking((("mixed (every 5)",), ("normal",)), "mixed has the higher mean"),
+                  MoreStable("mixed (every 5)", ("normal",), "mixed is more stable")),
+        notes="Fixed boxes TW=1 ('the same parametrization as the previous experiments')."),
+    Experiment(
+        "sword", "3.10", "Sword game (8 actions)", "fqi", env_id="ObjectWorldSword-v0",
+        sample_scale=2.0, defaults=_TUNED, settings=_REPRESENTATIONS,
+        thesis={"bounded TW=4": "up to 270,000 (best)", "random box": "up to 250,000",
+                "classic": "about 50,000, stable", "grid 10 + ridge": "never positive",
+                "fixed TW=1": "extremely unstable", "random policy": "about -6,000,000"},
+        findings=(Ranking((("bounded TW=4", "random box"), ("classic",), ("grid 10 + ridge",)),
+                          "bounded ~ random box > classic > grid"),
+                  Sign("classic", True, "classic trees reach a positive reward"),
+                  Sign("grid 10 + ridge", False, "grid + ridge stays negative"),
+                  MoreStable("bounded TW=4", ("fixed TW=1",),
+                             "fixed boxes are less stable than bounded ones"))),
+    # ---------------------------------------------------------------- beyond the thesis
+    Experiment(
+        "keep_data", "extra", "Keeping earlier data (thesis future work) vs normal and mixed",
+        "fqi", defaults={**_TUNED, "keep_data": True, "max_samples": 100_000},
+        settings={"keep data (100k)": {}, "normal": {"same_as": "sampling/normal"},
+                  "mixed (every 5)": {"same_as": "sampling/mixed (every 5)"}},
+        thesis={"keep data (100k)": "hypothesis: stable and high (future work)"},
+        findings=(Ranking((("keep data (100k)",), ("normal",)),
+                          "keeping data beats forgetting it (thesis's hypothesis)"),
+                  MoreStable("keep data (100k)", ("normal",),
+                             "keeping data is more stable than re-sampling")),
+        notes="The data set keeps the most recent 100,000 transitions (5 iterations)."),
+    Experiment(
+        "dqn", "extra", "stable-baselines3 DQN at the same environment steps", "dqn",
+        defaults={"n_bins": 10},
+        settings={"FQI fixed TW=1": {"same_as": "representations/fixed TW=1"},
+                  "FQI bounded TW=4": {"same_as": "representations/bounded TW=4"},
+                  "DQN (grid 10 obs)": {}},
+        findings=(Ranking((("FQI fixed TW=1", "FQI bounded TW=4"), ("DQN (grid 10 obs)",)),
+                          "box FQI beats DQN at equal environment steps"),),
+        notes="DQN: MLP 256x256 on the 10x10 grid-count observation, as many env steps as "
+              "one FQI run (iterations x samples), gamma as FQI; its score is the final "
+              "policy's reward, FQI's the mean of the last 5 iterations."),
+    Experiment(
+        "attention", "extra", "Most used tests of a learned Q-forest (style of Fig. 2.2)",
+        "attention", defaults={**_TUNED, "test_type": "bounded", "test_width": 4.0},
+        settings={"bounded TW=4": {}},
+        notes="Tests weighted by the number of training samples reaching their node; the "
+              "top boxes per action over a reference world's local view."),
+)
+
+REGISTRY = {experiment.name: experiment for experiment in EXPERIMENTS}
+
+
+def resolve(experiment, label):
+    """Follow ``same_as`` links to the experiment and label that own a setting's runs.
+
+    Parameters
+    ----------
+    experiment : Experiment
+    label : str
+
+    Returns
+    -------
+    owner : Experiment
+    owner_label : str
+    """
+    seen = set()
+    while "same_as" in experiment.settings[label]:
+        if (experiment.name, label) in seen:
+            raise ValueError(f"circular same_as at {experiment.name}/{label}")
+        seen.add((experiment.name, label))
+        name, label = experiment.settings[label]["same_as"].split("/", 1)
+        experiment = REGISTRY[name]
+    return experiment, label

@@ -1,0 +1,143 @@
+"""The one runner: plan the (experiment, setting, seed) units, run the unfinished ones with
+a progress bar, and gather the finished ones per setting."""
+from dataclasses import dataclass
+from pathlib import Path
+
+from joblib import Parallel, delayed
+from tqdm.auto import tqdm
+
+from .cache import load_unit, save_unit, unit_path
+from .registry import resolve
+from .stats import summarise
+from .units import run_unit
+
+__all__ = ["Unit", "plan", "run", "gather", "seeds_for"]
+
+
+@dataclass(frozen=True)
+class Unit:
+    """One run to do: a setting of the experiment owning it, at one seed."""
+
+    experiment: str
+    label: str
+    seed: int
+    params: dict
+    samples: int
+    path: Path
+
+    @property
+    def cost(self):
+        """Rough relative run time, for the progress bar's ETA."""
+        p = self.params
+        trees = p.get("n_estimators", 10) if p.get("model") == "box" else 10
+        if p["kind"] == "rmse":
+            return 0.5 * trees
+        if p["kind"] == "dqn":
+            return 40.0
+        return self.samples / 1000 * trees / 5
+
+
+def seeds_for(experiment, budget, seeds=None):
+    """Seeds of an experiment: `seeds` if given, else ``range(budget.seeds)``; the RMSE
+    study and the attention figure use one data set / forest (seed 0), as the thesis."""
+    if seeds is not None:
+        return list(seeds)
+    n = 1 if experiment.kind in ("rmse", "attention") else budget.seeds
+    return list(range(n))
+
+
+def plan(experiments, budget, out, seeds=None):
+    """Every unit the experiments need, each once (``same_as`` settings share their
+    owner's units).
+
+    Parameters
+    ----------
+    experiments : sequence of Experiment
+    budget : Budget
+    out : path-like
+    seeds : sequence of int, default=None
+        Overrides `seeds_for`.
+
+    Returns
+    -------
+    units : list of Unit
+    """
+    units = {}
+    for experiment in experiments:
+        for label in experiment.settings:
+            owner, owner_label = resolve(experiment, label)
+            samples = int(budget.samples * owner.sample_scale)
+            for seed in seeds_for(experiment, budget, seeds):
+                path = unit_path(out, budget, owner.name, owner_label, seed)
+                units.setdefault(path, Unit(owner.name, owner_label, seed,
+                                            owner.params(owner_label), samples, path))
+    return list(units.values())
+
+
+def _execute(unit, budget):
+    result = run_unit(unit.params, budget, unit.seed, unit.samples)
+    save_unit(unit.path, unit.params, budget, unit.samples, unit.experiment, unit.label,
+              unit.seed, result)
+    return unit, result["seconds"]
+
+
+def run(units, budget, jobs=1, progress=True):
+    """Run the units not already cached; show one progress bar with ETA over all of them.
+
+    Parameters
+    ----------
+    units : list of Unit
+    budget : Budget
+    jobs : int, default=1
+        Parallel processes (joblib loky). Each FQI run already uses every core for its
+        forests, so 1 is usually fastest.
+    progress : bool, default=True
+
+    Returns
+    -------
+    done : list of (Unit, float)
+        The units run now and their seconds (cached units are skipped).
+    """
+    # seed-major order: an interrupted run leaves every setting with its first seeds done
+    todo = sorted((u for u in units if load_unit(u.path, u.params, budget, u.samples) is None),
+                  key=lambda u: u.seed)
+    cached = len(units) - len(todo)
+    done = []
+    with tqdm(total=sum(u.cost for u in todo), disable=not progress, unit="cost",
+              bar_format="{l_bar}{bar}| [{elapsed}<{remaining}]{postfix}") as bar:
+        bar.set_postfix_str(f"{len(todo)} to run, {cached} cached")
+        if jobs == 1:
+            results = (_execute(u, budget) for u in todo)
+        else:
+            results = Parallel(n_jobs=jobs, return_as="generator_unordered")(
+                delayed(_execute)(u, budget) for u in todo)
+        for unit, seconds in results:
+            done.append((unit, seconds))
+            bar.update(unit.cost)
+            bar.set_postfix_str(f"{unit.experiment}/{unit.label}/seed{unit.seed} "
+                                f"{seconds:.0f}s; {len(done)}/{len(todo)} run, {cached} cached")
+    return done
+
+
+def gather(experiment, budget, out, seeds=None):
+    """Finished runs of each setting, summarised.
+
+    Returns
+    -------
+    stats : dict of str to SettingStats
+        Settings with at least one finished run, in registry order.
+    runs : dict of str to list of dict
+        The raw unit records per setting.
+    """
+    stats, runs = {}, {}
+    for label in experiment.settings:
+        owner, owner_label = resolve(experiment, label)
+        params = owner.params(owner_label)
+        samples = int(budget.samples * owner.sample_scale)
+        records = [load_unit(unit_path(out, budget, owner.name, owner_label, seed), params,
+                             budget, samples) for seed in seeds_for(experiment, budget, seeds)]
+        records = [r for r in records if r is not None]
+        if records:
+            runs[label] = records
+            stats[label] = summarise(label, params["kind"], [r["result"] for r in records])
+    return stats, runs

@@ -1,0 +1,21 @@
+"""Reproduce every experiment of the thesis, with plots and a report, in one command.
+
+    python benchmarks/run_all.py --quick          # every experiment, reduced budget, ~15 min
+    python benchmarks/run_all.py                  # the thesis's budgets (many hours; resumable)
+    python benchmarks/run_all.py --only representations,dqn --out docs/results
+    python benchmarks/run_all.py --report-only    # rebuild figures and REPORT.md from the cache
+
+Writes under ``--out`` (default ``results/``): one PNG per figure, ``runs/`` (one JSON per
+finished run, reused by later invocations), one CSV of raw numbers per experiment,
+``summary.json`` and ``REPORT.md``. The experiments are the registry in
+``benchmarks/reproduce/registry.py``.
+"""
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.reproduce.cli import main  # noqa: E402
+
+if __name__ == "__main__":
+    main()
