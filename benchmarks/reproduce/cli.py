@@ -45,8 +45,9 @@ def _parser():
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument("--quick", action="store_const", const="quick", dest="budget",
                       help="reduced budget (1 seed, 5 iterations x 5,000 samples), ~15 min")
-    mode.add_argument("--budget", choices=sorted(BUDGETS), default="full",
+    mode.add_argument("--budget", choices=sorted(BUDGETS),
                       help="named budget (default: full, the thesis's)")
+    parser.set_defaults(budget="full")
     parser.add_argument("--only", type=_experiments, default=None, metavar="NAME[,NAME]",
                         help=f"run only these experiments ({', '.join(REGISTRY)})")
     parser.add_argument("--seeds", type=parse_seeds, default=None,
