@@ -17,7 +17,7 @@ def _extension(name):
     return Extension(
         f"boxtrees.{name}",
         [f"boxtrees/{name}.pyx"],
-        include_dirs=[np.get_include()],
+        include_dirs=[np.get_include(), "boxtrees"],
         define_macros=[("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION")],
         extra_compile_args=compile_args,
         language="c++",

@@ -96,6 +96,26 @@ cdef inline intp_t _first_not_below(const coord_t* x, intp_t lo, intp_t hi, coor
 
 cnp.import_array()
 
+cdef extern from "_simd.h":
+    ctypedef intp_t (*boxtrees_compact_fn)(const coord_t* ys, const int32* sid, intp_t n,
+                                           coord_t ymin, coord_t ymax, int32* out) noexcept nogil
+    boxtrees_compact_fn boxtrees_select_compact(int allow_simd) noexcept nogil
+
+cdef enum:
+    COMPACT_SLACK = 16  # spare slots the SIMD compaction may write past its count
+
+# the strip compaction used by every tree (see _simd.h)
+cdef boxtrees_compact_fn _compact = boxtrees_select_compact(1)
+
+
+def _set_simd(bint enabled):
+    """Use the SIMD strip compaction when the CPU has it (default) or the portable one.
+
+    Both give identical trees; this switch exists to test that.
+    """
+    global _compact
+    _compact = boxtrees_select_compact(enabled)
+
 
 cdef inline void* _data(cnp.ndarray a) noexcept:
     return cnp.PyArray_DATA(a)
@@ -155,7 +175,8 @@ cdef class _Splitter:
             np.array(x, dtype=np.float32), np.array(y, dtype=np.float32),
             np.array(sample_of, dtype=np.int32),
             np.empty(n_objects, dtype=np.float32), np.empty(n_objects, dtype=np.float32),
-            np.empty(n_objects, dtype=np.int32), np.empty(n_objects, dtype=np.int32),
+            np.empty(n_objects, dtype=np.int32),
+            np.empty(n_objects + COMPACT_SLACK, dtype=np.int32),
             np.arange(n_samples, dtype=np.int32), np.zeros(n_samples, dtype=np.int32),
             np.empty(n_samples, dtype=np.int32), np.zeros(n_samples, dtype=np.uint8),
             np.empty(n_segments, dtype=np.intp), np.empty(n_segments, dtype=np.intp),
@@ -294,10 +315,7 @@ cdef class _Splitter:
                 inside = sid + a                # the band lies within the box's y extent
                 n = e - a
             else:
-                n = 0                           # branch-free compaction of the y test
-                for j in range(a, e):
-                    strip[n] = sid[j]
-                    n += (ys[j] > ymin) & (ys[j] < ymax)
+                n = _compact(ys + a, sid + a, e - a, ymin, ymax, strip)
                 inside = strip
             for j in range(n):
                 s = inside[j]

@@ -195,3 +195,20 @@ def test_max_depth_limits_trees():
     X, y = make_box_regression(500, random_state=0)
     forest = BoxExtraTreesRegressor(n_estimators=3, max_depth=3, min_samples_split=2, random_state=0).fit(X, y)
     assert max(t.max_depth for t in forest.estimators_) == 3
+
+
+def test_simd_and_portable_strip_compaction_grow_identical_trees():
+    from boxtrees import _builder
+
+    X, y = make_box_regression(1500, random_state=0)
+    params = dict(n_estimators=3, n_tests=50, min_samples_split=10, random_state=0)
+    try:
+        _builder._set_simd(False)
+        portable = BoxExtraTreesRegressor(test_type="random", **params).fit(X, y)
+    finally:
+        _builder._set_simd(True)
+    simd = BoxExtraTreesRegressor(test_type="random", **params).fit(X, y)
+    for a, b in zip(portable.estimators_, simd.estimators_):
+        np.testing.assert_array_equal(a.children_left, b.children_left)
+        np.testing.assert_array_equal(a.box, b.box)
+        np.testing.assert_array_equal(a.value, b.value)
