@@ -25,6 +25,7 @@ cdef packed struct PackedNode:   # the layout of boxtrees._tree.NODE_DTYPE
 cdef struct ForestView:
     const PackedNode* nodes
     const intp_t* tree_offsets   # first node of each tree in the packed arrays
+    intp_t n_trees
 
 
 cdef struct SampleView:
@@ -62,6 +63,7 @@ cdef inline void _views(ForestView* f, SampleView* s, forest, samples):
     cdef const intp_t[:, ::1] type_ptr = samples[2]
     f.nodes = &nodes[0]
     f.tree_offsets = &tree_offsets[0]
+    f.n_trees = tree_offsets.shape[0] - 1
     # an empty batch of objects still needs valid pointers; nothing is read through them
     s.x = &x[0] if x.shape[0] else NULL
     s.y = &y[0] if y.shape[0] else NULL
@@ -69,44 +71,50 @@ cdef inline void _views(ForestView* f, SampleView* s, forest, samples):
     s.stride = type_ptr.shape[1]
 
 
+cdef void _walk(const ForestView* f, const SampleView* s, intp_t start, intp_t stop,
+                const float64_t* value, float64_t* mean, intp_t* leaves) noexcept nogil:
+    """Walk samples ``start:stop`` through every tree, in blocks, tree by tree.
+
+    Writes the mean leaf value per sample into ``mean`` or, when ``mean`` is NULL, the
+    tree-local leaf ids into the (n_samples, n_trees) array ``leaves``.
+    """
+    cdef intp_t n_trees = f.n_trees, block = start, block_end, tree, i, leaf
+    while block < stop:
+        block_end = min(block + <intp_t>BLOCK, stop)
+        if mean != NULL:
+            for i in range(block, block_end):
+                mean[i] = 0.0
+        for tree in range(n_trees):
+            for i in range(block, block_end):
+                leaf = _find_leaf(f, s, tree, i)
+                if mean != NULL:
+                    mean[i] += value[f.tree_offsets[tree] + leaf]
+                else:
+                    leaves[i * n_trees + tree] = leaf
+        if mean != NULL:
+            for i in range(block, block_end):
+                mean[i] /= n_trees
+        block = block_end
+
+
 def predict_mean(forest, samples, intp_t start, intp_t stop, float64_t[::1] out):
     """Write the mean leaf value over the trees for samples ``start:stop`` into ``out``.
 
     ``forest`` carries the packed node arrays (see ``boxtrees._tree.PackedForest``) and
-    ``samples`` is the triple returned by :func:`group_by_type`.
+    ``samples`` is the triple returned by ``boxtrees._rows.group_by_type``.
     """
     cdef ForestView f
     cdef SampleView s
     cdef const float64_t[::1] value = forest.value
-    cdef intp_t n_trees = forest.tree_offsets.shape[0] - 1
-    cdef intp_t block, i, tree, block_end
     _views(&f, &s, forest, samples)
     with nogil:
-        block = start
-        while block < stop:
-            block_end = min(block + <intp_t>BLOCK, stop)
-            for i in range(block, block_end):
-                out[i] = 0.0
-            for tree in range(n_trees):
-                for i in range(block, block_end):
-                    out[i] += value[f.tree_offsets[tree] + _find_leaf(&f, &s, tree, i)]
-            for i in range(block, block_end):
-                out[i] /= n_trees
-            block = block_end
+        _walk(&f, &s, start, stop, &value[0], &out[0], NULL)
 
 
 def apply_leaves(forest, samples, intp_t start, intp_t stop, intp_t[:, ::1] out):
     """Write the tree-local leaf index of samples ``start:stop`` in every tree into ``out``."""
     cdef ForestView f
     cdef SampleView s
-    cdef intp_t n_trees = forest.tree_offsets.shape[0] - 1
-    cdef intp_t block, i, tree, block_end
     _views(&f, &s, forest, samples)
     with nogil:
-        block = start
-        while block < stop:
-            block_end = min(block + <intp_t>BLOCK, stop)
-            for tree in range(n_trees):
-                for i in range(block, block_end):
-                    out[i, tree] = _find_leaf(&f, &s, tree, i)
-            block = block_end
+        _walk(&f, &s, start, stop, NULL, NULL, &out[0, 0])
