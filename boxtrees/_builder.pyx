@@ -117,10 +117,6 @@ def _set_simd(bint enabled):
     _compact = boxtrees_select_compact(enabled)
 
 
-cdef inline void* _data(cnp.ndarray a) noexcept:
-    return cnp.PyArray_DATA(a)
-
-
 cdef class _Splitter:
     """Draws, scores and applies the box tests of the node being split.
 
@@ -128,7 +124,7 @@ cdef class _Splitter:
     scratch arrays. Segment ``g = type * n_bands + band`` of the current node is
     ``lo[g]:hi[g]``.
     """
-    cdef list _keep_alive            # the NumPy arrays behind the pointers below
+    cdef list _keep_alive            # the NumPy arrays behind the pointers below (see _own)
     cdef coord_t* xs
     cdef coord_t* ys
     cdef int32* sid
@@ -171,42 +167,28 @@ cdef class _Splitter:
                   double width, intp_t n_tests, intp_t max_retries, uint64 seed):
         cdef intp_t n_objects = max(len(x), 1), n_samples = len(target)
         cdef intp_t n_segments = bounds.shape[0] * (len(band_edges) - 1)
-        arrays = [
-            np.array(x, dtype=np.float32), np.array(y, dtype=np.float32),
-            np.array(sample_of, dtype=np.int32),
-            np.empty(n_objects, dtype=np.float32), np.empty(n_objects, dtype=np.float32),
-            np.empty(n_objects, dtype=np.int32),
-            np.empty(n_objects + COMPACT_SLACK, dtype=np.int32),
-            np.arange(n_samples, dtype=np.int32), np.zeros(n_samples, dtype=np.int32),
-            np.empty(n_samples, dtype=np.int32), np.zeros(n_samples, dtype=np.uint8),
-            np.empty(n_segments, dtype=np.intp), np.empty(n_segments, dtype=np.intp),
-            np.ascontiguousarray(target, dtype=np.float64),
-            np.ascontiguousarray(weight, dtype=np.float64),
-            np.ascontiguousarray(band_edges, dtype=np.float64),
-            np.asarray(weight, dtype=np.float64) * np.asarray(target, dtype=np.float64),
-            np.empty(4 * bounds.shape[0], dtype=np.float64),
-            np.empty(bounds.shape[0], dtype=np.intp),
-        ]
-        self._keep_alive = arrays
-        self.xs = <coord_t*>_data(arrays[0])
-        self.ys = <coord_t*>_data(arrays[1])
-        self.sid = <int32*>_data(arrays[2])
-        self.tmp_x = <coord_t*>_data(arrays[3])
-        self.tmp_y = <coord_t*>_data(arrays[4])
-        self.tmp_sid = <int32*>_data(arrays[5])
-        self.strip = <int32*>_data(arrays[6])
-        self.samples = <int32*>_data(arrays[7])
-        self.counts = <int32*>_data(arrays[8])
-        self.hits = <int32*>_data(arrays[9])
-        self.goes_right = <uint8*>_data(arrays[10])
-        self.lo = <intp_t*>_data(arrays[11])
-        self.hi = <intp_t*>_data(arrays[12])
-        self.target = <const float64_t*>_data(arrays[13])
-        self.weight = <const float64_t*>_data(arrays[14])
-        self.edges = <const float64_t*>_data(arrays[15])
-        self.weighted_target = <float64_t*>_data(arrays[16])
-        self.region = <double*>_data(arrays[17])
-        self.type_size = <intp_t*>_data(arrays[18])
+        self._keep_alive = []
+        self.xs = <coord_t*>self._own(np.array(x, dtype=np.float32))
+        self.ys = <coord_t*>self._own(np.array(y, dtype=np.float32))
+        self.sid = <int32*>self._own(np.array(sample_of, dtype=np.int32))
+        self.tmp_x = <coord_t*>self._own(np.empty(n_objects, dtype=np.float32))
+        self.tmp_y = <coord_t*>self._own(np.empty(n_objects, dtype=np.float32))
+        self.tmp_sid = <int32*>self._own(np.empty(n_objects, dtype=np.int32))
+        self.strip = <int32*>self._own(np.empty(n_objects + COMPACT_SLACK, dtype=np.int32))
+        self.samples = <int32*>self._own(np.arange(n_samples, dtype=np.int32))
+        self.counts = <int32*>self._own(np.zeros(n_samples, dtype=np.int32))
+        self.hits = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
+        self.goes_right = <uint8*>self._own(np.zeros(n_samples, dtype=np.uint8))
+        self.lo = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
+        self.hi = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
+        target = np.ascontiguousarray(target, dtype=np.float64)
+        weight = np.ascontiguousarray(weight, dtype=np.float64)
+        self.target = <const float64_t*>self._own(target)
+        self.weight = <const float64_t*>self._own(weight)
+        self.weighted_target = <float64_t*>self._own(weight * target)
+        self.edges = <const float64_t*>self._own(np.ascontiguousarray(band_edges, dtype=np.float64))
+        self.region = <double*>self._own(np.empty(4 * bounds.shape[0], dtype=np.float64))
+        self.type_size = <intp_t*>self._own(np.empty(bounds.shape[0], dtype=np.intp))
         self.bounds = bounds
         self.n_samples = n_samples
         self.n_types = bounds.shape[0]
@@ -246,6 +228,11 @@ cdef class _Splitter:
                 if self.local_x and self.hi[g] > self.lo[g]:
                     r[0] = min(r[0], self.xs[self.lo[g]])
                     r[1] = max(r[1], self.xs[self.hi[g] - 1])
+
+    cdef void* _own(self, cnp.ndarray array):
+        """Keep ``array`` alive as long as the splitter and return its data pointer."""
+        self._keep_alive.append(array)
+        return cnp.PyArray_DATA(array)
 
     cdef bint sample_test(self, BoxTest* t) noexcept nogil:
         """Draw a test; False when its type has no object in the node (it cannot split)."""
