@@ -64,7 +64,7 @@ BUDGETS = {
                     rmse_samples=5_000, rmse_folds=3, dqn_steps=25_000,
                     attention_iterations=3),
     # for the tests: every experiment end to end in seconds
-    "tiny": Budget("tiny", seeds=1, iterations=1, samples=400, eval_steps=100,
-                   rmse_samples=400, rmse_folds=2, dqn_steps=300, attention_iterations=1, max_trees=2,
-                   max_tests=20),
+    "tiny": Budget("tiny", seeds=1, iterations=2, samples=200, eval_steps=50,
+                   rmse_samples=200, rmse_folds=2, dqn_steps=100, attention_iterations=1,
+                   max_trees=2, max_tests=10),
 }

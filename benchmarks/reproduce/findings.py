@@ -79,18 +79,17 @@ class Ranking:
                     for b in lower:
                         note = _gap_note(stats[a], stats[b])
                         if not _better(stats[a], stats[b]):
-                            wrong.append(f"{b} ({_fmt(stats[b].score)}) >= {a} "
-                                         f"({_fmt(stats[a].score)}){note}")
+                            wrong.append(f"{b} not worse than {a}{note}")
                         elif note:
                             noisy.append(f"{a} vs {b}")
-        order = " > ".join(f"{label} {_fmt(stats[label].score)}" for label in sorted(
+        order = ", ".join(f"{label} {_fmt(stats[label].score)}" for label in sorted(
             labels, key=lambda label: stats[label].score,
             reverse=not stats[labels[0]].lower_is_better))
         if wrong:
-            return Verdict(self.claim, False, f"measured {order}; out of order: "
+            return Verdict(self.claim, False, f"measured, best first: {order}; out of order: "
                                               + "; ".join(wrong))
         tail = f"; holds but within noise for {', '.join(noisy)}" if noisy else ""
-        return Verdict(self.claim, True, f"measured {order}{tail}")
+        return Verdict(self.claim, True, f"measured, best first: {order}{tail}")
 
 
 @dataclass(frozen=True)

@@ -1,3 +1,210 @@
+"""Outputs of a reproduction: figures, raw numbers (CSV, JSON) and REPORT.md."""
+import csv
+import json
+import math
+import time
 from pathlib import Path
-def write_outputs(experiments, budget, out, seeds, elapsed, n_run):
-    return Path(out) / "REPORT.md"
+
+from .plots import ACTION_NAMES, TYPE_NAMES, plot_experiment
+from .registry import EXPERIMENTS
+from .runner import gather, seeds_for
+from .stats import LAST_WINDOW
+
+__all__ = ["write_outputs", "figure_name"]
+
+
+def figure_name(experiment):
+    """File name of an experiment's figure, e.g. ``fig3.6_representations.png``."""
+    prefix = "extra" if experiment.figure == "extra" else f"fig{experiment.figure}"
+    return f"{prefix}_{experiment.name}.png"
+
+
+def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None):
+    """Write every figure with finished runs, the raw CSVs, ``summary.json`` and
+    ``REPORT.md`` under `out`, and print the summary table.
+
+    The report covers every registry experiment (not only `experiments`), so that a full
+    reproduction spread over several invocations reports all that is finished so far.
+
+    Parameters
+    ----------
+    experiments : sequence of Experiment
+        Those run by this invocation (named in the report's header).
+    budget : Budget
+    out : path-like
+    seeds : sequence of int, default=None
+        As given to the runner (None: the budget's).
+    elapsed : float, default=None
+        Seconds this invocation spent running.
+    n_run : int, default=None
+        Units this invocation ran (the rest were cached).
+
+    Returns
+    -------
+    report : pathlib.Path
+    """
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    sections, summary, rows = [], {}, []
+    for experiment in EXPERIMENTS:
+        stats, runs = gather(experiment, budget, out, seeds)
+        planned = len(experiment.settings) * len(seeds_for(experiment, budget, seeds))
+        done = sum(s.n_runs for s in stats.values())
+        verdicts = [rule.check(stats) for rule in experiment.findings] if stats else []
+        if stats:
+            plot_experiment(experiment, stats, runs, budget, out / figure_name(experiment))
+            _write_csv(experiment, runs, out / f"{experiment.name}.csv")
+        summary[experiment.name] = _summary_entry(experiment, stats, verdicts, done, planned)
+        sections.append(_section(experiment, stats, runs, verdicts, done, planned))
+        rows.extend((experiment, v, done, planned) for v in verdicts)
+        if not experiment.findings:
+            rows.append((experiment, None, done, planned))
+    (out / "summary.json").write_text(json.dumps(
+        {"budget": budget.name, "experiments": summary}, indent=1, allow_nan=True))
+    report = out / "REPORT.md"
+    report.write_text(_header(experiments, budget, seeds, elapsed, n_run)
+                      + _summary_table(rows) + "\n".join(sections))
+    print(_console_summary(rows))
+    return report
+
+
+def _fmt(value, digits=0):
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    return f"{value:,.{digits}f}"
+
+
+def _header(experiments, budget, seeds, elapsed, n_run):
+    ran = ", ".join(e.name for e in experiments)
+    timing = "" if elapsed is None else (f" This invocation ran {n_run} run(s) in "
+                                         f"{elapsed / 60:.1f} min ({ran}).")
+    dqn_steps = budget.dqn_steps or budget.iterations * budget.samples
+    return (
+        f"# Reproducing the thesis: report ({budget.name} budget)\n\n"
+        f"Written by `python benchmarks/run_all.py` on {time.strftime('%Y-%m-%d %H:%M')}."
+        f"{timing} Finished runs are cached under `runs/{budget.name}/`; re-running the "
+        f"command resumes.\n\n"
+        f"Budget `{budget.name}`: {budget.seeds} run(s) per setting"
+        f"{'' if seeds is None else f' (seeds {list(seeds)})'}, {budget.iterations} "
+        f"iterations x {budget.samples:,} samples (x2 for the sword game), greedy evaluation "
+        f"over {budget.eval_steps:,} steps on the fixed reference worlds"
+        f"{'' if budget.eval_steps == 20_000 else ' (fewer than the thesis: rewards rescaled)'}"
+        f"; every reward is per 20,000 steps as in the thesis. RMSE: {budget.rmse_folds}-fold "
+        f"CV on {budget.rmse_samples:,} random-policy samples. DQN: {dqn_steps:,} env steps."
+        + ("" if budget.max_trees is None else
+           f" Forests capped at {budget.max_trees} trees, {budget.max_tests} tests.")
+        + f"\n\nScores: FQI = mean reward of the last {LAST_WINDOW} iterations (mean over "
+        f"runs, +- sd over runs); 'within noise' = the gap is under 2 standard errors of the "
+        f"averaged rewards. Verdicts are computed from these numbers by the rules in "
+        f"`benchmarks/reproduce/registry.py`.\n\n")
+
+
+def _summary_table(rows):
+    lines = ["## Summary", "", "| figure | experiment | runs | thesis finding | reproduces? "
+             "| measured |", "| --- | --- | --- | --- | --- | --- |"]
+    for experiment, verdict, done, planned in rows:
+        claim, mark, text = ("(no claim: extra)", "-", "") if verdict is None else \
+            (verdict.claim, verdict.mark, verdict.explanation)
+        lines.append(f"| {experiment.figure} | [{experiment.name}](#{experiment.name}) | "
+                     f"{done}/{planned} | {claim} | {mark} | {text} |")
+    return "\n".join(lines) + "\n\n"
+
+
+def _console_summary(rows):
+    lines = [f"{'figure':<7} {'experiment':<16} {'runs':>7}  {'holds':<5} finding"]
+    for experiment, verdict, done, planned in rows:
+        mark, claim = ("-", "(extra)") if verdict is None else (verdict.mark, verdict.claim)
+        lines.append(f"{experiment.figure:<7} {experiment.name:<16} {done:>3}/{planned:<3}  "
+                     f"{mark:<5} {claim}")
+    return "\n".join(lines)
+
+
+def _section(experiment, stats, runs, verdicts, done, planned):
+    figure = "" if experiment.figure == "extra" else f" (thesis Fig. {experiment.figure})"
+    lines = [f"<a id=\"{experiment.name}\"></a>", f"## {experiment.title}{figure}", ""]
+    if not stats:
+        return "\n".join(lines + ["Not run at this budget yet.", ""])
+    status = "" if done == planned else f" **Partial: {done} of {planned} runs finished.**"
+    lines += [f"`{experiment.name}`, {done}/{planned} runs.{status}", "",
+              f"![{experiment.name}]({figure_name(experiment)})", ""]
+    lines += _table(experiment, stats, runs)
+    if verdicts:
+        lines += ["", "Thesis findings, checked on these numbers:", ""]
+        lines += [f"- {v.claim}: **{v.mark}**. {v.explanation}" for v in verdicts]
+    if experiment.notes:
+        lines += ["", f"Notes: {experiment.notes}"]
+    return "\n".join(lines + [""])
+
+
+def _table(experiment, stats, runs):
+    """The setting table: our numbers beside the thesis's."""
+    thesis = experiment.thesis
+    if experiment.kind == "attention":
+        return _attention_table(runs)
+    if experiment.kind == "rmse":
+        lines = ["| setting | RMSE (mean over folds and actions) | sd over folds | thesis |",
+                 "| --- | --- | --- | --- |"]
+        for label, s in stats.items():
+            folds = [f for r in runs[label] for f in r["result"]["fold_rmse"]]
+            sd = (sum((f - s.score) ** 2 for f in folds) / max(len(folds) - 1, 1)) ** 0.5
+            lines.append(f"| {label} | {s.score:.2f} | {sd:.2f} | {thesis.get(label, '')} |")
+        return lines
+    lines = ["| setting | runs | score +- sd over runs | best evaluation | mean abs. change "
+             "between iterations | minutes per run | thesis |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
+    for label, s in stats.items():
+        lines.append(f"| {label} | {s.n_runs} | {_fmt(s.score)} +- {_fmt(s.score_sd)} | "
+                     f"{_fmt(s.best)} | {_fmt(s.instability)} | {s.seconds / 60:.1f} | "
+                     f"{thesis.get(label, '')} |")
+    randoms = [s.random_reward for s in stats.values() if not math.isnan(s.random_reward)]
+    if randoms:
+        lines.append(f"| random policy | | {_fmt(sum(randoms) / len(randoms))} | | | | "
+                     f"{thesis.get('random policy', '')} |")
+    return lines
+
+
+def _attention_table(runs):
+    (label, records), = runs.items()
+    result = records[0]["result"]
+    n_types = len(result["actions"][0]["type_usage"])
+    lines = [f"Reward of the drawn Q-function: {_fmt(result['reward'])}. Share of training "
+             f"samples passing each type's tests (sample-weighted test usage), per action:", "",
+             "| action | " + " | ".join(TYPE_NAMES[t] for t in range(n_types)) + " |",
+             "| --- |" + " --- |" * n_types]
+    for action, info in enumerate(result["actions"]):
+        lines.append(f"| {ACTION_NAMES[action]} | "
+                     + " | ".join(f"{u:.0%}" for u in info["type_usage"]) + " |")
+    return lines
+
+
+def _summary_entry(experiment, stats, verdicts, done, planned):
+    return {
+        "figure": experiment.figure, "title": experiment.title, "runs": done,
+        "planned": planned,
+        "settings": {label: {"n_runs": s.n_runs, "score": s.score, "score_sd": s.score_sd,
+                             "score_se": s.score_se, "best": s.best,
+                             "instability": s.instability, "random_reward": s.random_reward,
+                             "seconds": s.seconds, "thesis": experiment.thesis.get(label)}
+                     for label, s in stats.items()},
+        "findings": [{"claim": v.claim, "holds": v.holds, "explanation": v.explanation}
+                     for v in verdicts],
+    }
+
+
+def _write_csv(experiment, runs, path):
+    """Raw per-run numbers: one row per iteration (FQI), fold (RMSE) or run (DQN)."""
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["experiment", "setting", "seed", "step", "value", "seconds"])
+        for label, records in runs.items():
+            for record in records:
+                result, seed = record["result"], record["seed"]
+                if "rewards" in result:  # fqi: step 0 is the random policy
+                    values = [result["random_reward"], *result["rewards"]]
+                elif "fold_rmse" in result:
+                    values = result["fold_rmse"]
+                else:
+                    values = [result["reward"]]
+                for step, value in enumerate(values):
+                    writer.writerow([experiment.name, label, seed, step, value,
+                                     round(result["seconds"], 2)])

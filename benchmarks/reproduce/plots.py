@@ -1,0 +1,148 @@
+"""Figures in the thesis's form: reward curves with a std band, RMSE bars, the DQN
+comparison, and the attention figure (most used test boxes over a local view)."""
+import matplotlib
+
+matplotlib.use("Agg")
+import gymnasium as gym  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.patches import Patch, Rectangle  # noqa: E402
+
+import envs  # noqa: E402
+
+from .stats import LAST_WINDOW  # noqa: E402
+
+__all__ = ["plot_experiment", "TYPE_NAMES", "ACTION_NAMES"]
+
+# Colours of the object types, as the env's renderer draws them (envs/_render.py).
+_TYPE_COLOURS = {envs.MONEY: "#e2b212", envs.WALL: "#64646a", envs.GRASS: "#4ca848",
+                 envs.ENEMY: "#d42c2c", envs.MONEY_MARKER: "#ff7f0e",
+                 envs.TREASURE_MARKER: "#285adc", envs.ARROW: "#8c3cc8"}
+TYPE_NAMES = {envs.MONEY: "money", envs.WALL: "wall", envs.GRASS: "grass",
+               envs.ENEMY: "enemy", envs.MONEY_MARKER: "money marker",
+               envs.TREASURE_MARKER: "treasure marker", envs.ARROW: "arrow"}
+ACTION_NAMES = ("up", "right", "down", "left", "swipe up", "swipe right", "swipe down",
+                 "swipe left")
+
+
+def plot_experiment(experiment, stats, runs, budget, path):
+    """Draw the experiment's figure to `path` (PNG).
+
+    Parameters
+    ----------
+    experiment : Experiment
+    stats : dict of str to SettingStats
+        Settings with finished runs.
+    runs : dict of str to list of dict
+        Their raw unit records (the attention figure draws from them).
+    budget : Budget
+    path : path-like
+    """
+    draw = {"fqi": _curves, "rmse": _bars, "dqn": _dqn, "attention": _attention}
+    fig = draw[experiment.kind](experiment, stats, runs, budget)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def _title(experiment, budget, stats):
+    runs = sorted({s.n_runs for s in stats.values()})
+    figure = f"Fig. {experiment.figure}: " if experiment.figure != "extra" else ""
+    return (f"{figure}{experiment.title}\n({budget.name} budget, "
+            f"{'/'.join(map(str, runs))} run(s) per setting)")
+
+
+def _curves(experiment, stats, runs, budget):
+    """Mean reward per iteration with a +-1 sd band over runs; iteration 0 is the random
+    policy (left out for the sword game, as in the thesis: it would dwarf the curves)."""
+    fig, ax = plt.subplots(figsize=(7.5, 4.5))
+    first = 1 if experiment.env_id == "ObjectWorldSword-v0" else 0
+    for label, s in stats.items():
+        x = np.arange(first, len(s.curve_mean))
+        mean, sd = s.curve_mean[first:], s.curve_sd[first:]
+        ax.plot(x, mean, marker="o", markersize=3, label=f"{label} ({s.score:,.0f})")
+        ax.fill_between(x, mean - sd, mean + sd, alpha=0.2)
+    ax.axhline(0, color="grey", lw=0.6)
+    ax.set_xlabel("iteration (0: random policy)" if first == 0 else "iteration")
+    ax.set_ylabel("reward per 20,000 greedy steps")
+    ax.set_title(_title(experiment, budget, stats), fontsize=10)
+    ax.legend(fontsize=8, title=f"setting (mean of last {LAST_WINDOW} it.)",
+              title_fontsize=8)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def _bars(experiment, stats, runs, budget):
+    """Appendix A: mean cross-validated RMSE per setting, error bars 1 sd over folds."""
+    fig, ax = plt.subplots(figsize=(6, 4))
+    labels = list(stats)
+    means = [stats[label].score for label in labels]
+    sds = [np.std([f for r in runs[label] for f in r["result"]["fold_rmse"]])
+           for label in labels]
+    best = int(np.argmin(means))
+    colours = ["tab:green" if i == best else "tab:blue" for i in range(len(labels))]
+    ax.bar(labels, means, yerr=sds, capsize=4, color=colours)
+    low = min(m - s for m, s in zip(means, sds))
+    high = max(m + s for m, s in zip(means, sds))
+    ax.set_ylim(max(0.0, low - 0.3 * (high - low)), high + 0.1 * (high - low))
+    ax.set_ylabel(f"RMSE ({budget.rmse_folds}-fold CV, mean over actions)")
+    ax.set_title(_title(experiment, budget, stats), fontsize=10)
+    ax.grid(axis="y", alpha=0.3)
+    return fig
+
+
+def _dqn(experiment, stats, runs, budget):
+    """Reward (mean +- sd over runs) and wall time per run of FQI and DQN."""
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    labels = list(stats)
+    ax.bar(labels, [stats[label].score for label in labels],
+           yerr=[stats[label].score_sd for label in labels], capsize=4,
+           color=["tab:blue" if stats[label].kind == "fqi" else "tab:orange"
+                  for label in labels])
+    for i, label in enumerate(labels):
+        ax.annotate(f"{stats[label].seconds / 60:.1f} min/run", (i, 0), ha="center",
+                    va="bottom", fontsize=8, xytext=(0, 3), textcoords="offset points")
+    ax.axhline(0, color="grey", lw=0.6)
+    ax.set_ylabel("reward per 20,000 greedy steps")
+    ax.set_title(_title(experiment, budget, stats), fontsize=10)
+    ax.grid(axis="y", alpha=0.3)
+    return fig
+
+
+def _attention(experiment, stats, runs, budget):
+    """Per action, the most informative test boxes of the Q-forest (outline colour: the
+    tested type; line width: the test's weighted variance reduction) over the local view of
+    a reference world the agent never trained on."""
+    (label, records), = runs.items()
+    result = records[0]["result"]
+    params = experiment.params(label)
+    env = gym.make(params["env_id"], render_mode="rgb_array", render_view="local")
+    env.reset(seed=result["world_seed"])
+    image = env.render()
+    extent = env.unwrapped.rules.obs_bound + 1.0  # the local render's half-side
+    env.close()
+    n_actions = len(result["actions"])
+    cols = 4
+    rows = -(-n_actions // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.3 * cols, 3.6 * rows + 0.6), squeeze=False)
+    strongest = max((t[7] for a in result["actions"] for t in a["tests"]), default=1.0) or 1.0
+    for action, (ax, info) in enumerate(zip(axes.flat, result["actions"])):
+        ax.imshow(image, extent=(-extent, extent, -extent, extent))
+        for xmin, xmax, ymin, ymax, kind, threshold, _, reduction in info["tests"]:
+            box = np.clip([xmin, xmax, ymin, ymax], -extent, extent)
+            ax.add_patch(Rectangle((box[0], box[2]), box[1] - box[0], box[3] - box[2],
+                                   fill=False, lw=0.6 + 3.0 * reduction / strongest,
+                                   edgecolor=_TYPE_COLOURS[int(kind)]))
+        top = np.argsort(info["type_usage"])[::-1][:2]
+        usage = ", ".join(f"{TYPE_NAMES[t]} {info['type_usage'][t]:.0%}" for t in top)
+        ax.set_title(f"{ACTION_NAMES[action]}: Q = {result['q_values'][action]:,.0f}\n"
+                     f"tests on {usage}", fontsize=8)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    for ax in axes.flat[n_actions:]:
+        ax.axis("off")
+    types = sorted({int(t[4]) for a in result["actions"] for t in a["tests"]})
+    fig.legend(handles=[Patch(edgecolor=_TYPE_COLOURS[t], fill=False, label=TYPE_NAMES[t])
+                        for t in types], loc="lower center", ncol=len(types), fontsize=8)
+    fig.suptitle(f"Most informative tests per action, {label} Q-forest after "
+                 f"{budget.attention_iterations} iterations ({budget.name} budget)", fontsize=10)
+    return fig

@@ -1,0 +1,232 @@
+"""benchmarks/run_all.py: registry, runner (end to end at the tiny budget), cache and resume,
+findings and the report writer."""
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from benchmarks.reproduce import BUDGETS, EXPERIMENTS, REGISTRY
+from benchmarks.reproduce.cache import load_unit, save_unit, slug, unit_path
+from benchmarks.reproduce.cli import main, parse_seeds
+from benchmarks.reproduce.findings import (Falls, HighestPeak, MoreStable, NearRandom,
+                                           Ranking, Sign, Similar)
+from benchmarks.reproduce.registry import Experiment, resolve
+from benchmarks.reproduce.report import figure_name, write_outputs
+from benchmarks.reproduce.runner import plan, run
+from benchmarks.reproduce.stats import SettingStats, summarise
+
+TINY = BUDGETS["tiny"]
+
+
+# ------------------------------------------------------------------------------ registry
+def test_registry_covers_every_thesis_figure_once():
+    figures = [e.figure for e in EXPERIMENTS if e.figure != "extra"]
+    assert sorted(figures) == sorted(["A.1", "A.2", "A.3", "A.4", "A.5", "3.1", "3.2", "3.3",
+                                      "3.4", "3.5", "3.6", "3.8", "3.9", "3.10"])
+    assert {e.name for e in EXPERIMENTS if e.figure == "extra"} == {"keep_data", "dqn",
+                                                                    "attention"}
+    assert len(REGISTRY) == len(EXPERIMENTS)
+
+
+def _rule_labels(rule):
+    labels = []
+    for name in ("groups", "labels", "others"):
+        value = getattr(rule, name, ())
+        labels += [x for group in value for x in group] if name == "groups" else list(value)
+    labels += [getattr(rule, name) for name in ("label", "stable", "reference")
+               if hasattr(rule, name)]
+    return labels
+
+
+@pytest.mark.parametrize("experiment", EXPERIMENTS, ids=lambda e: e.name)
+def test_every_setting_resolves_and_every_rule_names_real_settings(experiment):
+    assert experiment.kind in {"fqi", "rmse", "dqn", "attention"}
+    for label in experiment.settings:
+        owner, owner_label = resolve(experiment, label)
+        params = owner.params(owner_label)
+        assert params["kind"] in {"fqi", "rmse", "dqn", "attention"}
+        assert params["env_id"].startswith("ObjectWorld")
+        if params.get("model", "box") == "box" and params["kind"] != "dqn":
+            assert {"test_type", "n_estimators", "n_tests", "min_samples_split"} <= set(params)
+    for rule in experiment.findings:
+        assert set(_rule_labels(rule)) <= set(experiment.settings), rule
+
+
+def test_thesis_axes_and_budgets():
+    assert list(REGISTRY["fqi_nmin"].settings) == ["n_min=10", "n_min=20", "n_min=30"]
+    assert list(REGISTRY["rmse_grid"].settings) == ["N=5", "N=10", "N=16", "N=21"]
+    assert REGISTRY["fqi_K"].params("K=50")["n_estimators"] == 15  # standard M
+    assert REGISTRY["representations"].params("classic")["n_tests"] == 500  # tuned K
+    assert REGISTRY["treasure"].params("global")["view"] == "global"
+    full = BUDGETS["full"]
+    assert (full.seeds, full.iterations, full.samples, full.eval_steps) == (5, 20, 20_000,
+                                                                             20_000)
+    sword = [u for u in plan([REGISTRY["sword"]], full, "out") if u.seed == 0]
+    assert {u.samples for u in sword} == {40_000}
+
+
+def test_same_as_settings_share_their_owners_units(tmp_path):
+    units = plan([REGISTRY["representations"], REGISTRY["dqn"]], BUDGETS["full"], tmp_path)
+    assert len(units) == 5 * 5 + 5  # DQN's FQI settings are the representations' runs
+    assert len({u.path for u in units}) == len(units)
+    owners = {(u.experiment, u.label) for u in plan([REGISTRY["dqn"]], TINY, tmp_path)}
+    assert ("representations", "fixed TW=1") in owners
+
+
+def test_circular_same_as_is_rejected():
+    loop = Experiment("loop", "extra", "t", "fqi", settings={"a": {"same_as": "loop/a"}})
+    REGISTRY["loop"] = loop
+    try:
+        with pytest.raises(ValueError, match="circular"):
+            resolve(loop, "a")
+    finally:
+        del REGISTRY["loop"]
+
+
+def test_parse_seeds():
+    assert parse_seeds("3") == [0, 1, 2]
+    assert parse_seeds("0,2,4") == [0, 2, 4]
+    assert parse_seeds("2-4") == [2, 3, 4]
+    with pytest.raises(Exception, match="count"):
+        parse_seeds("x")
+
+
+# ------------------------------------------------------------------------------ cache
+def test_cache_round_trip_and_mismatch(tmp_path):
+    params = REGISTRY["fqi_K"].params("K=50")
+    path = unit_path(tmp_path, TINY, "fqi_K", "K=50", 0)
+    assert path == tmp_path / "runs" / "tiny" / "fqi_K" / "K-50" / "seed0.json"
+    save_unit(path, params, TINY, 200, "fqi_K", "K=50", 0, {"rewards": [1.0], "seconds": 1})
+    assert load_unit(path, params, TINY, 200)["result"]["rewards"] == [1.0]
+    assert list(path.parent.iterdir()) == [path]  # no temporary file left behind
+    assert load_unit(path, {**params, "n_tests": 51}, TINY, 200) is None  # other params
+    assert load_unit(path, params, TINY, 400) is None  # other samples per iteration
+    assert load_unit(path, params, replace(TINY, iterations=3), 200) is None
+    assert load_unit(path, params, replace(TINY, seeds=4), 200) is not None  # irrelevant
+    assert load_unit(path, params, replace(TINY, name="quick"), 200) is None
+    path.write_text("{truncated")
+    assert load_unit(path, params, TINY, 200) is None
+    assert slug("mixed (every 5)") == "mixed_every_5"
+
+
+# ------------------------------------------------------------------------------ end to end
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("run_all")
+    report = main(["--budget", "tiny", "--out", str(out), "--no-progress"])
+    return out, report
+
+
+def test_every_experiment_runs_end_to_end(tiny_run):
+    out, report = tiny_run
+    for experiment in EXPERIMENTS:
+        assert (out / figure_name(experiment)).stat().st_size > 5000, experiment.name
+        assert (out / f"{experiment.name}.csv").exists()
+    text = report.read_text()
+    for experiment in EXPERIMENTS:
+        assert f'<a id="{experiment.name}"></a>' in text
+    assert "Partial" not in text
+    summary = json.loads((out / "summary.json").read_text())
+    assert set(summary["experiments"]) == set(REGISTRY)
+    fqi = summary["experiments"]["representations"]["settings"]["fixed TW=1"]
+    assert fqi["n_runs"] == 1 and np.isfinite(fqi["score"])
+    record = json.loads(unit_path(out, TINY, "representations", "fixed TW=1", 0).read_text())
+    assert len(record["result"]["rewards"]) == TINY.iterations
+    assert record["result"]["history"][0]["n_samples"] == TINY.samples
+    sword = json.loads(unit_path(out, TINY, "sword", "classic", 0).read_text())
+    assert sword["result"]["history"][0]["n_samples"] == 2 * TINY.samples
+    rmse = json.loads(unit_path(out, TINY, "rmse_K", "K=300", 0).read_text())["result"]
+    assert len(rmse["fold_rmse"]) == TINY.rmse_folds and len(rmse["action_rmse"]) == 4
+    attention = json.loads(unit_path(out, TINY, "attention", "bounded TW=4", 0).read_text())
+    assert len(attention["result"]["actions"]) == 4
+    assert all(len(t) == 8 for a in attention["result"]["actions"] for t in a["tests"])
+
+
+def test_second_invocation_reuses_the_cache_and_resumes(tiny_run):
+    out, _ = tiny_run
+    units = plan([REGISTRY["representations"]], TINY, out)
+    assert run(units, TINY, progress=False) == []  # everything cached
+    units[2].path.unlink()
+    before = units[0].path.stat().st_mtime_ns
+    rerun = run(units, TINY, progress=False)
+    assert [u.path for u, _ in rerun] == [units[2].path]
+    assert units[2].path.exists() and units[0].path.stat().st_mtime_ns == before
+
+
+def test_report_marks_missing_runs_as_partial(tiny_run, tmp_path):
+    out, _ = tiny_run
+    report = main(["--budget", "tiny", "--out", str(out), "--seeds", "2",
+                   "--only", "sampling", "--report-only", "--no-progress"])
+    text = report.read_text()
+    assert "Partial: 2 of 4 runs finished" in text  # seed 1 never ran
+
+
+# ------------------------------------------------------------------------------ findings
+def _stats(label, score, se=1.0, **kwargs):
+    return SettingStats(label, "fqi", 1, score, 0.0, se, **kwargs)
+
+
+def test_ranking_holds_fails_and_flags_noise():
+    rule = Ranking((("a", "b"), ("c",)), "a ~ b > c")
+    good = {"a": _stats("a", 100), "b": _stats("b", 90), "c": _stats("c", 10)}
+    assert rule.check(good).holds is True
+    assert rule.check({**good, "c": _stats("c", 95)}).holds is False
+    assert "c not worse than b" in rule.check({**good, "c": _stats("c", 95)}).explanation
+    assert "within noise" in rule.check({**good, "c": _stats("c", 89)}).explanation
+    assert rule.check({"a": good["a"]}).holds is None  # settings not run
+
+
+def test_ranking_lower_is_better_for_rmse():
+    rule = Ranking((("K=300",), ("K=50",)), "K=300 lowest")
+    rmse = {"K=300": SettingStats("K=300", "rmse", 1, 1.0, 0, 0.01, lower_is_better=True),
+            "K=50": SettingStats("K=50", "rmse", 1, 2.0, 0, 0.01, lower_is_better=True)}
+    assert rule.check(rmse).holds is True
+
+
+def test_other_rules():
+    a, b = _stats("a", 100, instability=5, best=200, random_reward=-100), \
+        _stats("b", 0, instability=50, best=150, random_reward=-100)
+    stats = {"a": a, "b": b}
+    assert Similar(("a", "b"), "").check(stats).holds is False
+    assert Similar(("a", "b"), "").check({"a": a, "b": _stats("b", 99)}).holds is True
+    assert MoreStable("a", ("b",), "").check(stats).holds is True
+    assert MoreStable("b", ("a",), "").check(stats).holds is False
+    assert Sign("b", True, "").check(stats).holds is False
+    assert Sign("a", True, "").check(stats).holds is True
+    assert NearRandom("b", "a", "").check({"a": a, "b": _stats("b", -90, random_reward=-100)}
+                                          ).holds is True
+    assert HighestPeak("a", ("a", "b"), "").check(stats).holds is True
+    assert Falls(("b", "a"), "").check(stats).holds is True
+
+
+def test_summarise_fqi_runs():
+    runs = [{"rewards": [0.0, 10.0, 20.0], "random_reward": -5.0, "seconds": 2.0},
+            {"rewards": [0.0, 30.0, 40.0], "random_reward": -7.0, "seconds": 4.0}]
+    s = summarise("x", "fqi", runs)
+    assert s.score == pytest.approx((10 + 30) / 2)  # mean of all 3 iterations (< 5)
+    assert s.curve_mean.tolist() == [-6.0, 0.0, 20.0, 30.0]
+    assert s.instability == pytest.approx(10.0) and s.best == 40.0 and s.seconds == 3.0
+
+
+# ------------------------------------------------------------------------------ report
+def test_report_shows_thesis_numbers_beside_ours_and_computed_verdicts(tmp_path):
+    experiment = REGISTRY["sampling"]
+    budget = replace(TINY, iterations=3)
+    for label, curves in {"normal": ([90e3, 10e3, 50e3], [80e3, 20e3, 50e3]),
+                          "mixed (every 5)": ([50e3, 60e3, 70e3], [55e3, 65e3, 75e3])}.items():
+        params = experiment.params(label)
+        for seed, curve in enumerate(curves):
+            save_unit(unit_path(tmp_path, budget, "sampling", label, seed), params, budget,
+                      budget.samples, "sampling", label, seed,
+                      {"rewards": list(curve), "random_reward": -95e3, "seconds": 60.0})
+    report = write_outputs([experiment], budget, tmp_path, seeds=[0, 1])
+    text = report.read_text()
+    section = text[text.index('<a id="sampling">'):]
+    assert "| mixed (every 5) | 2 | 62,500 +- 3,536 |" in section  # mean of the 3 it.
+    assert "more stable, higher mean" in section  # the thesis's statement beside ours
+    assert "- mixed has the higher mean: **yes**" in section
+    assert "- mixed is more stable: **yes**" in section
+    assert "| 3.9 | [sampling](#sampling) | 4/4 | mixed has the higher mean | yes |" in text
+    assert (tmp_path / "fig3.9_sampling.png").exists()
+    assert "Not run at this budget yet." in text  # the other experiments
