@@ -162,19 +162,20 @@ cdef class _Splitter:
     cdef double wy_sum
     cdef double tie                  # proxies closer than this are ties (rounding noise)
 
-    def __cinit__(self, x, y, sample_of, target, weight, band_edges,
+    def __cinit__(self, x, y, sample_of, intp_t max_segment, target, weight, band_edges,
                   const coord_t[:, ::1] bounds, bint local_x, bint one_per_sample, int kind,
                   double width, intp_t n_tests, intp_t max_retries, uint64 seed):
-        cdef intp_t n_objects = max(len(x), 1), n_samples = len(target)
+        cdef intp_t n_samples = len(target)
         cdef intp_t n_segments = bounds.shape[0] * (len(band_edges) - 1)
         self._keep_alive = []
         self.xs = <coord_t*>self._own(np.array(x, dtype=np.float32))
         self.ys = <coord_t*>self._own(np.array(y, dtype=np.float32))
         self.sid = <int32*>self._own(np.array(sample_of, dtype=np.int32))
-        self.tmp_x = <coord_t*>self._own(np.empty(n_objects, dtype=np.float32))
-        self.tmp_y = <coord_t*>self._own(np.empty(n_objects, dtype=np.float32))
-        self.tmp_sid = <int32*>self._own(np.empty(n_objects, dtype=np.int32))
-        self.strip = <int32*>self._own(np.empty(n_objects + COMPACT_SLACK, dtype=np.int32))
+        # scratch for one segment at a time: its right-going objects, or a strip's hits
+        self.tmp_x = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
+        self.tmp_y = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
+        self.tmp_sid = <int32*>self._own(np.empty(max_segment, dtype=np.int32))
+        self.strip = <int32*>self._own(np.empty(max_segment + COMPACT_SLACK, dtype=np.int32))
         self.samples = <int32*>self._own(np.arange(n_samples, dtype=np.int32))
         self.counts = <int32*>self._own(np.zeros(n_samples, dtype=np.int32))
         self.hits = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
@@ -566,9 +567,10 @@ def build_tree(x, y, sample_of, const intp_t[::1] segment_ptr, band_edges, targe
     seed : int
         Seed of the tree's random generator.
     """
+    cdef intp_t max_segment = max(np.diff(segment_ptr).max(initial=0), 1)
     cdef _Splitter splitter = _Splitter(
-        x, y, sample_of, target, weight, band_edges, bounds, local_x, one_per_sample,
-        TEST_KINDS[test_type], test_width, n_tests, max_retries, seed)
+        x, y, sample_of, max_segment, target, weight, band_edges, bounds, local_x,
+        one_per_sample, TEST_KINDS[test_type], test_width, n_tests, max_retries, seed)
     cdef vector[Node] nodes
     with nogil:
         _grow(splitter, &nodes, segment_ptr, min_samples_split, max_depth)
