@@ -4,7 +4,7 @@
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
-SOURCES := setup.py pyproject.toml constraints.txt $(wildcard boxtrees/*.pyx boxtrees/*.pxd)
+SOURCES := setup.py pyproject.toml constraints.txt $(wildcard boxtrees/*.pyx boxtrees/*.pxd boxtrees/*.h)
 
 .PHONY: bench test install clean
 
