@@ -7,13 +7,14 @@ import numpy as np
 import pytest
 
 from benchmarks.reproduce import BUDGETS, EXPERIMENTS, REGISTRY
-from benchmarks.reproduce.cache import load_unit, save_unit, slug, unit_path
+from benchmarks.reproduce.cache import (attempts, load_unit, mark_attempt, save_unit, slug,
+                                        unit_path)
 from benchmarks.reproduce.cli import main, parse_seeds
 from benchmarks.reproduce.findings import (Falls, HighestPeak, MoreStable, NearRandom,
                                            Ranking, Sign, Similar)
 from benchmarks.reproduce.registry import Experiment, resolve
 from benchmarks.reproduce.report import figure_name, write_outputs
-from benchmarks.reproduce.runner import plan, run
+from benchmarks.reproduce.runner import MAX_ATTEMPTS, plan, run
 from benchmarks.reproduce.stats import SettingStats, summarise
 
 TINY = BUDGETS["tiny"]
@@ -154,6 +155,20 @@ def test_second_invocation_reuses_the_cache_and_resumes(tiny_run):
     assert units[2].path.exists() and units[0].path.stat().st_mtime_ns == before
 
 
+def test_units_that_crashed_run_last_and_are_skipped_after_max_attempts(tiny_run):
+    out, _ = tiny_run
+    units = plan([REGISTRY["fqi_K"]], TINY, out)
+    for u in units:
+        u.path.unlink()
+    mark_attempt(units[0].path)  # crashed once: retried after the others
+    for _ in range(MAX_ATTEMPTS):
+        mark_attempt(units[1].path)  # crashed too often: skipped
+    assert attempts(units[1].path) == MAX_ATTEMPTS
+    rerun = [u.path for u, _ in run(units, TINY, progress=False)]
+    assert rerun == [units[2].path, units[0].path]
+    assert attempts(units[0].path) == 0 and not units[1].path.exists()
+
+
 def test_report_marks_missing_runs_as_partial(tiny_run, tmp_path):
     out, _ = tiny_run
     report = main(["--budget", "tiny", "--out", str(out), "--seeds", "2",
@@ -204,9 +219,9 @@ def test_summarise_fqi_runs():
     runs = [{"rewards": [0.0, 10.0, 20.0], "random_reward": -5.0, "seconds": 2.0},
             {"rewards": [0.0, 30.0, 40.0], "random_reward": -7.0, "seconds": 4.0}]
     s = summarise("x", "fqi", runs)
-    assert s.score == pytest.approx((10 + 30) / 2)  # mean of all 3 iterations (< 5)
+    assert s.score == pytest.approx((10 + 70 / 3) / 2)  # mean of all 3 iterations (< 5)
     assert s.curve_mean.tolist() == [-6.0, 0.0, 20.0, 30.0]
-    assert s.instability == pytest.approx(10.0) and s.best == 40.0 and s.seconds == 3.0
+    assert s.instability == pytest.approx(15.0) and s.best == 40.0 and s.seconds == 3.0
 
 
 # ------------------------------------------------------------------------------ report

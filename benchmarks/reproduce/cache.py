@@ -2,7 +2,9 @@
 
 Layout: ``<out>/runs/<budget>/<experiment>/<setting>/seed<k>.json``. A file counts as
 finished only if its recorded parameters and budget equal the current ones, so a changed
-registry entry or budget re-runs the unit instead of mixing results.
+registry entry or budget re-runs the unit instead of mixing results. Beside it,
+``seed<k>.json.attempts`` counts starts that never finished (the interpreter crashed or was
+killed), so the runner can try such units last and eventually give up on them.
 """
 import json
 import os
@@ -10,7 +12,7 @@ import re
 import tempfile
 from pathlib import Path
 
-__all__ = ["unit_path", "load_unit", "save_unit", "slug"]
+__all__ = ["unit_path", "load_unit", "save_unit", "slug", "attempts", "mark_attempt"]
 
 
 def slug(label):
@@ -86,6 +88,26 @@ def save_unit(path, params, budget, samples, experiment, label, seed, result):
         with os.fdopen(fd, "w") as f:
             json.dump(record, f, indent=1, allow_nan=True)
         os.replace(tmp, path)
+        _attempts_path(path).unlink(missing_ok=True)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _attempts_path(path):
+    return Path(f"{path}.attempts")
+
+
+def attempts(path):
+    """How many times the unit at `path` was started without finishing."""
+    try:
+        return int(_attempts_path(path).read_text())
+    except (OSError, ValueError):
+        return 0
+
+
+def mark_attempt(path):
+    """Record that the unit at `path` starts (`save_unit` clears the record)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    _attempts_path(path).write_text(str(attempts(path) + 1))

@@ -1,17 +1,21 @@
 """The one runner: plan the (experiment, setting, seed) units, run the unfinished ones with
 a progress bar, and gather the finished ones per setting."""
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
-from .cache import load_unit, save_unit, unit_path
+from .cache import attempts, load_unit, mark_attempt, save_unit, unit_path
 from .registry import resolve
 from .stats import summarise
 from .units import run_unit
 
-__all__ = ["Unit", "plan", "run", "gather", "seeds_for"]
+__all__ = ["Unit", "plan", "run", "gather", "seeds_for", "MAX_ATTEMPTS"]
+
+# A unit that crashed the interpreter this many times is skipped (and reported missing).
+MAX_ATTEMPTS = 3
 
 
 @dataclass(frozen=True)
@@ -75,6 +79,7 @@ def plan(experiments, budget, out, seeds=None):
 
 
 def _execute(unit, budget):
+    mark_attempt(unit.path)
     result = run_unit(unit.params, budget, unit.seed, unit.samples)
     save_unit(unit.path, unit.params, budget, unit.samples, unit.experiment, unit.label,
               unit.seed, result)
@@ -98,10 +103,16 @@ def run(units, budget, jobs=1, progress=True):
     done : list of (Unit, float)
         The units run now and their seconds (cached units are skipped).
     """
-    # seed-major order: an interrupted run leaves every setting with its first seeds done
+    # Seed-major order, so an interrupted run leaves every setting with its first seeds
+    # done; units that crashed before go last, and are skipped after MAX_ATTEMPTS crashes.
     todo = sorted((u for u in units if load_unit(u.path, u.params, budget, u.samples) is None),
-                  key=lambda u: u.seed)
+                  key=lambda u: (attempts(u.path), u.seed))
     cached = len(units) - len(todo)
+    failing = [u for u in todo if attempts(u.path) >= MAX_ATTEMPTS]
+    for u in failing:
+        print(f"skipping {u.experiment}/{u.label}/seed{u.seed}: it crashed {attempts(u.path)} "
+              f"times (delete {u.path}.attempts to retry)", file=sys.stderr)
+    todo = todo[:len(todo) - len(failing)]
     done = []
     with tqdm(total=sum(u.cost for u in todo), disable=not progress, unit="cost",
               bar_format="{l_bar}{bar}| [{elapsed}<{remaining}]{postfix}") as bar:
