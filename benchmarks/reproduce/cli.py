@@ -44,7 +44,7 @@ def _parser():
                     "an interrupted run resumes where it stopped.")
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument("--quick", action="store_const", const="quick", dest="budget",
-                      help="reduced budget (1 seed, 5 iterations x 5,000 samples), ~15 min")
+                      help="reduced budget (1 seed, 5 iterations x 4,000 samples), ~15 min")
     mode.add_argument("--budget", choices=sorted(BUDGETS),
                       help="named budget (default: full, the thesis's)")
     parser.set_defaults(budget="full")

@@ -29,16 +29,21 @@ class Unit:
     samples: int
     path: Path
 
-    @property
-    def cost(self):
-        """Rough relative run time, for the progress bar's ETA."""
+    def cost(self, budget):
+        """Rough run time in seconds on 2 free cores (measured at the quick budget), for
+        the progress bar's ETA."""
         p = self.params
-        trees = p.get("n_estimators", 10) if p.get("model") == "box" else 10
-        if p["kind"] == "rmse":
-            return 0.5 * trees
         if p["kind"] == "dqn":
-            return 40.0
-        return self.samples / 1000 * trees / 5
+            return 2.5e-3 * (budget.dqn_steps or budget.iterations * self.samples)
+        trees = (p["n_estimators"] / 15 * (p["n_tests"] / 300) ** 0.5
+                 if p.get("model") == "box" else 3.0)
+        if p["kind"] == "rmse":
+            return 0.1 * budget.rmse_samples / 1000 * budget.rmse_folds / 3 * trees
+        iterations = (budget.attention_iterations if p["kind"] == "attention"
+                      else budget.iterations)
+        actions = 2.0 if p["env_id"] == "ObjectWorldSword-v0" else 1.0
+        kept = 3.0 if p.get("keep_data") else 1.0
+        return 0.3 * iterations * self.samples / 1000 * trees * actions * kept
 
 
 def seeds_for(experiment, budget, seeds=None):
@@ -114,7 +119,7 @@ def run(units, budget, jobs=1, progress=True):
               f"times (delete {u.path}.attempts to retry)", file=sys.stderr)
     todo = todo[:len(todo) - len(failing)]
     done = []
-    with tqdm(total=sum(u.cost for u in todo), disable=not progress, unit="cost",
+    with tqdm(total=sum(u.cost(budget) for u in todo), disable=not progress, unit="s",
               bar_format="{l_bar}{bar}| [{elapsed}<{remaining}]{postfix}") as bar:
         bar.set_postfix_str(f"{len(todo)} to run, {cached} cached")
         if jobs == 1:
@@ -124,7 +129,7 @@ def run(units, budget, jobs=1, progress=True):
                 delayed(_execute)(u, budget) for u in todo)
         for unit, seconds in results:
             done.append((unit, seconds))
-            bar.update(unit.cost)
+            bar.update(unit.cost(budget))
             bar.set_postfix_str(f"{unit.experiment}/{unit.label}/seed{unit.seed} "
                                 f"{seconds:.0f}s; {len(done)}/{len(todo)} run, {cached} cached")
     return done
