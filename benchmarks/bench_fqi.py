@@ -91,8 +91,9 @@ def plot(runs, anchors, path):
                        label=f"DQN ({run['env_steps']:,} steps)")
     for label, value, style in [("random policy", anchors["random"], ":"),
                                 ("thesis box FQI (~100k)", THESIS_LEVEL, "-."),
-                                ("thesis human (~150k)", HUMAN_LEVEL, "-.")]:
+                                ("thesis human (~150k)", HUMAN_LEVEL, "--")]:
         ax.axhline(value, color="grey", ls=style, lw=1, label=label)
+    ax.xaxis.get_major_locator().set_params(integer=True)
     ax.set_xlabel("iteration")
     ax.set_ylabel("reward over 20,000 greedy steps (reference worlds)")
     ax.set_title("Fitted Q-iteration on ObjectWorld-v0")
