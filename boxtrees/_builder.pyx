@@ -178,7 +178,9 @@ cdef class _Splitter:
         self.strip = <int32*>self._own(np.empty(max_segment + COMPACT_SLACK, dtype=np.int32))
         self.samples = <int32*>self._own(np.arange(n_samples, dtype=np.int32))
         self.counts = <int32*>self._own(np.zeros(n_samples, dtype=np.int32))
-        self.hits = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
+        # one spare slot: the branch-free scatter in count() stores a sample id before it
+        # knows whether the sample is new, so with every sample hit it writes one past them
+        self.hits = <int32*>self._own(np.empty(n_samples + 1, dtype=np.int32))
         self.goes_right = <uint8*>self._own(np.zeros(n_samples, dtype=np.uint8))
         self.lo = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
         self.hi = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
