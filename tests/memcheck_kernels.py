@@ -1,0 +1,79 @@
+"""Drive every Cython kernel of boxtrees through edge cases; run under valgrind by
+test_boxtrees_memcheck.py, which fails on any invalid read or write in boxtrees code.
+
+Imports only NumPy and the extension modules (not scikit-learn), to stay fast under valgrind.
+"""
+import importlib
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+
+# load boxtrees' extension modules without running the package __init__ (scikit-learn)
+package = types.ModuleType("boxtrees")
+package.__path__ = [str(Path(__file__).resolve().parents[1] / "boxtrees")]
+sys.modules["boxtrees"] = package
+_builder = importlib.import_module("boxtrees._builder")
+_predictor = importlib.import_module("boxtrees._predictor")
+_rows = importlib.import_module("boxtrees._rows")
+_tree = importlib.import_module("boxtrees._tree")
+
+
+def training_arrays(rng, n, per_sample, n_types, n_bands, spread):
+    """Random objects (``per_sample`` each, or 0 to ``-per_sample`` if negative), indexed the
+    way BoxExtraTreesRegressor does."""
+    sizes = np.full(n, per_sample) if per_sample >= 0 else rng.integers(0, 1 - per_sample, n)
+    data = np.column_stack([rng.uniform(-spread, spread, (sizes.sum(), 2)),
+                            rng.integers(0, n_types, sizes.sum())]).astype(np.float32)
+    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.intp)
+    sample = np.repeat(np.arange(n), sizes).astype(np.int32)
+    edges = np.concatenate([[-np.inf], np.linspace(-1, 1, n_bands + 1)[1:-1], [np.inf]])
+    bands = np.searchsorted(edges[1:-1], data[:, 1], side="right")
+    segments = data[:, 2].astype(np.intp) * n_bands + bands
+    order = np.lexsort((data[:, 0], segments))
+    segment_ptr = np.searchsorted(segments[order], np.arange(n_types * n_bands + 1)).astype(np.intp)
+    return (data, offsets, np.ascontiguousarray(data[order, 0]), np.ascontiguousarray(data[order, 1]),
+            sample[order], segment_ptr, edges)
+
+
+def main():
+    rng = np.random.default_rng(0)
+    for case, (n, per_sample, n_types, n_bands, spread) in enumerate(
+        # boxes hitting every sample (several times), ragged sets, no objects, objects outside
+        # the bounds, two samples
+        [(40, 6, 1, 1, 0.5), (60, -12, 3, 4, 1.0), (30, 0, 2, 3, 1.0), (50, -3, 4, 8, 5.0),
+         (2, 1, 1, 1, 1.0)]
+    ):
+        data, offsets, x, y, sample, segment_ptr, edges = training_arrays(
+            rng, n, per_sample, n_types, n_bands, spread)
+        target, weight = rng.normal(size=n), rng.uniform(0.5, 2, n)
+        bounds = np.tile(np.array([-1, 1, -1, 1], dtype=np.float32), (n_types, 1))
+        for test_type in ("random", "fixed", "bounded", "classic"):
+            for simd in (True, False):
+                _builder._set_simd(simd)
+                trees = [_tree.BoxTree(**_builder.build_tree(
+                    x, y, sample, segment_ptr, edges, target, weight, bounds, False, False,
+                    test_type, 0.7, 20, 2.0, -1, 2, seed)) for seed in range(3)]
+            forest = _tree.PackedForest(trees)
+            samples = _rows.group_by_type(data, offsets, n_types)
+            _predictor.predict_mean(forest, samples, 0, n, np.empty(n))
+            _predictor.apply_leaves(forest, samples, 0, n, np.empty((n, 3), dtype=np.intp))
+            assert _rows.scan_rows(data, 3e38, 2**24)[0] == 0, case
+    # one object per sample and type: the strip-sum scoring path
+    n, n_features = 80, 3
+    values = rng.normal(size=(n, n_features)).astype(np.float32)
+    order = np.argsort(values, axis=0, kind="stable")
+    x = np.concatenate([values[order[:, j], j] for j in range(n_features)])
+    sample = np.concatenate([order[:, j] for j in range(n_features)]).astype(np.int32)
+    segment_ptr = np.arange(0, n * n_features + 1, n).astype(np.intp)
+    bounds = np.tile(np.array([0, 0, -np.inf, np.inf], dtype=np.float32), (n_features, 1))
+    for test_type in ("classic", "random", "fixed"):
+        _builder.build_tree(x, np.zeros_like(x), sample, segment_ptr, np.array([-np.inf, np.inf]),
+                            rng.normal(size=n), np.ones(n), bounds, True, True, test_type, 0.3,
+                            n_features, 2.0, -1, 2, 1)
+    print("kernels ok")
+
+
+if __name__ == "__main__":
+    main()
