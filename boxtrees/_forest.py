@@ -256,8 +256,11 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         samples = group_by_type(sets.data, sets.offsets, self.n_types_)
         n = len(sets)
         out = out(n)
-        n_jobs = min(effective_n_jobs(self.n_jobs), max(n // (_PARALLEL_PREDICT_MIN_SAMPLES // 2), 1))
-        if n_jobs == 1 or n < _PARALLEL_PREDICT_MIN_SAMPLES:
+        # chunks of at least half the threshold each; joblib is not even asked for small batches
+        n_jobs = 1
+        if n >= _PARALLEL_PREDICT_MIN_SAMPLES:
+            n_jobs = min(effective_n_jobs(self.n_jobs), n // (_PARALLEL_PREDICT_MIN_SAMPLES // 2))
+        if n_jobs == 1:
             kernel(self._packed, samples, 0, n, out)
         else:
             edges = np.linspace(0, n, n_jobs + 1).astype(np.intp)
