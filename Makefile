@@ -9,7 +9,7 @@ SOURCES := setup.py pyproject.toml constraints.txt $(wildcard boxtrees/*.pyx box
 .PHONY: bench test install clean
 
 bench: $(VENV)/.installed
-	$(PY) benchmarks/bench_trees.py --quick
+	$(PY) benchmarks/run_all.py --quick
 
 test: $(VENV)/.installed
 	$(PY) -m pytest -q tests
