@@ -209,6 +209,7 @@ def test_other_rules():
     assert MoreStable("b", ("a",), "").check(stats).holds is False
     assert Sign("b", True, "").check(stats).holds is False
     assert Sign("a", True, "").check(stats).holds is True
+    assert Sign("a", True, "").check({"a": _stats("a", 1.5)}).holds is False  # noise
     assert NearRandom("b", "a", "").check({"a": a, "b": _stats("b", -90, random_reward=-100)}
                                           ).holds is True
     assert HighestPeak("a", ("a", "b"), "").check(stats).holds is True

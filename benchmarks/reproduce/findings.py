@@ -141,7 +141,8 @@ class MoreStable:
 
 @dataclass(frozen=True)
 class Sign:
-    """The score of `label` is positive (``positive=True``) or negative."""
+    """The score of `label` is positive (``positive=True``) or negative, by more than
+    `_NOISE_SE` standard errors."""
 
     label: str
     positive: bool
@@ -151,9 +152,12 @@ class Sign:
         missing = _missing(self.claim, stats, (self.label,))
         if missing:
             return missing
-        score = stats[self.label].score
-        return Verdict(self.claim, (score > 0) == self.positive,
-                       f"measured {self.label} {_fmt(score)}")
+        s = stats[self.label]
+        margin = _NOISE_SE * s.score_se
+        clear = not math.isnan(margin) and abs(s.score) >= margin
+        note = "" if clear else f" (within noise of 0: 2 SE = {_fmt(margin)})"
+        return Verdict(self.claim, clear and (s.score > 0) == self.positive,
+                       f"measured {self.label} {_fmt(s.score)}{note}")
 
 
 @dataclass(frozen=True)

@@ -69,9 +69,8 @@ class Experiment:
 
     def params(self, label):
         """Full parameters of a setting (defaults, env and kind filled in)."""
-        params = {"kind": self.kind, "env_id": self.env_id, **self.defaults,
-                  **self.settings[label]}
-        return params
+        return {"kind": self.kind, "env_id": self.env_id, **self.defaults,
+                **self.settings[label]}
 
 
 def _axis(name, figure, title, key, values, label, base, **kwargs):
