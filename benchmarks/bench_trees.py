@@ -94,10 +94,17 @@ def plot(rows, path):
     labels = [f"{r['model']}\n(n={r['n_samples']})" for r in rows]
     fig, axes = plt.subplots(1, 2, figsize=(12, 0.55 * len(rows) + 1.5), sharey=True)
     colours = ["tab:blue" if r["model"].startswith("box") else "tab:grey" for r in rows]
-    axes[0].barh(labels, [r["fit_s"] for r in rows], color=colours)
-    axes[0].set_xlabel("fit time (s)")
+    fit = [r["fit_s"] for r in rows]
+    axes[0].barh(labels, fit, color=colours)
+    axes[0].set_xscale("log")
+    axes[0].set_xlabel("fit time (s, log scale)")
     axes[1].barh(labels, [r["r2"] for r in rows], color=colours)
     axes[1].set_xlabel("held-out $R^2$")
+    for i, r in enumerate(rows):
+        axes[0].text(r["fit_s"], i, f" {r['fit_s']:.2f} s", va="center")
+        axes[1].text(r["r2"], i, f" {r['r2']:.3f}", va="center")
+    axes[0].set_xlim(right=max(fit) * 6)
+    axes[1].set_xlim(0, 1.15)
     axes[0].invert_yaxis()
     fig.suptitle("BoxExtraTreesRegressor vs scikit-learn ExtraTreesRegressor (30 trees, n_min=30)")
     fig.tight_layout()
@@ -141,8 +148,12 @@ def main():
           f"{summary['object_fit_speedup_vs_sklearn_grid']:.1f}x (target >= 5x at N=20,000)")
     print(f"dense fit speed-up vs sklearn: {summary['dense_fit_speedup_vs_sklearn']:.2f}x (target >= 1x)")
     print(f"single-sample predict: {latency_us:.1f} us (target <= 50 us)")
+    load = os.getloadavg()[1]
+    print(f"load average over the last 5 minutes: {load:.1f} on {os.cpu_count()} cores "
+          "(other processes slow both sides)")
     report = {"rows": rows, "summary": summary, "n_jobs": args.n_jobs, "cpu_count": os.cpu_count(),
-              "machine": platform.machine(), "python": platform.python_version()}
+              "load_average_5min": load, "machine": platform.machine(),
+              "python": platform.python_version()}
     (out / "bench_trees.json").write_text(json.dumps(report, indent=2))
     plot(rows, out / "bench_trees.png")
     print(f"wrote {out / 'bench_trees.json'} and {out / 'bench_trees.png'}")
