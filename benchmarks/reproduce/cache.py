@@ -61,6 +61,15 @@ def load_unit(path, params, budget, samples):
     """The cached result at `path`, or None if missing, unreadable or made with other
     parameters or another budget.
 
+    Parameters
+    ----------
+    path : path-like
+    params : dict
+        The setting's current parameters.
+    budget : Budget
+    samples : int
+        Samples per FQI iteration of this unit.
+
     Returns
     -------
     record : dict or None
@@ -78,7 +87,19 @@ def load_unit(path, params, budget, samples):
 
 def save_unit(path, params, budget, samples, experiment, label, seed, result):
     """Write a unit's result atomically (temporary file in the same folder, then rename),
-    so an interrupted run never leaves a half-written file that looks finished."""
+    so an interrupted run never leaves a half-written file that looks finished; clear its
+    attempt count.
+
+    Parameters
+    ----------
+    path : path-like
+    params, budget, samples
+        As for `load_unit`: recorded so that later loads can check them.
+    experiment, label : str
+    seed : int
+    result : dict
+        JSON-ready output of `reproduce.units.run_unit`.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     record = {"experiment": experiment, "setting": label, "seed": seed,

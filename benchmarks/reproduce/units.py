@@ -17,7 +17,7 @@ from fqi import FQI, RandomPolicy, evaluate, make_box_forest, make_grid_ridge, t
 __all__ = ["run_unit", "GAMMA"]
 
 # Discount factor of every FQI and DQN run (the thesis does not state one; 0.5 scored best
-# in benchmarks/gamma_fqi.py). Pinned here so a changed library default cannot silently
+# in the measured comparison of README section "fqi"). Pinned here so a changed library default cannot silently
 # change cached results.
 GAMMA = 0.5
 _TOP_TESTS = 12  # boxes drawn per action in the attention figure
