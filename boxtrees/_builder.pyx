@@ -4,7 +4,8 @@ The training objects are kept in contiguous *segments*, one per (type, y band): 
 cut into a few bands and the objects of a segment are sorted by x. Each node owns one
 contiguous range of every segment. A box test visits the bands its y extent overlaps and
 binary-searches the x strip of its box in each, so its cost is the number of objects in that
-narrow strip, not in the node; bands lying wholly inside the box need no y comparison at all.
+narrow strip, not in the node; bands lying wholly inside the box need no y comparison at all,
+and short ranges (deep nodes) are tested whole, x and y at once, with no search.
 Only samples hit by the box get a non-zero count, which is all the threshold draw and the score
 need. Splitting a node partitions every segment range stably, so both children keep their
 objects sorted by x. Nodes are grown depth first from an explicit stack: fixed 2 x 2 boxes make
@@ -100,12 +101,19 @@ cdef extern from "_simd.h":
     ctypedef intp_t (*boxtrees_compact_fn)(const coord_t* ys, const int32* sid, intp_t n,
                                            coord_t ymin, coord_t ymax, int32* out) noexcept nogil
     boxtrees_compact_fn boxtrees_select_compact(int allow_simd) noexcept nogil
+    ctypedef intp_t (*boxtrees_compact_box_fn)(const coord_t* xs, const coord_t* ys,
+                                               const int32* sid, intp_t n, coord_t xmin,
+                                               coord_t xmax, coord_t ymin, coord_t ymax,
+                                               int32* out) noexcept nogil
+    boxtrees_compact_box_fn boxtrees_select_compact_box(int allow_simd) noexcept nogil
 
 cdef enum:
+    SHORT_SEGMENT = 160  # segments up to this long are scanned whole instead of searched
     COMPACT_SLACK = 16  # spare slots the SIMD compaction may write past its count
 
 # the strip compaction used by every tree (see _simd.h)
 cdef boxtrees_compact_fn _compact = boxtrees_select_compact(1)
+cdef boxtrees_compact_box_fn _compact_box = boxtrees_select_compact_box(1)
 
 
 def _set_simd(bint enabled):
@@ -113,8 +121,9 @@ def _set_simd(bint enabled):
 
     Both give identical trees; this switch exists to test that.
     """
-    global _compact
+    global _compact, _compact_box
     _compact = boxtrees_select_compact(enabled)
+    _compact_box = boxtrees_select_compact_box(enabled)
 
 
 cdef class _Splitter:
@@ -298,15 +307,21 @@ cdef class _Splitter:
             if edges[band + 1] <= ymin or edges[band] >= ymax:
                 continue
             g = t.object_type * self.n_bands + band
-            a = _first_above(xs, self.lo[g], self.hi[g], t.xmin)
-            e = _first_not_below(xs, a, self.hi[g], t.xmax)
-            if ((ymin < edges[band] or ymin == -INFINITY)
-                    and (edges[band + 1] <= ymax or ymax == INFINITY)):
-                inside = sid + a                # the band lies within the box's y extent
-                n = e - a
-            else:
-                n = _compact(ys + a, sid + a, e - a, ymin, ymax, strip)
+            if self.hi[g] - self.lo[g] <= SHORT_SEGMENT:
+                # a short segment is tested whole, x and y at once: no search
+                n = _compact_box(xs + self.lo[g], ys + self.lo[g], sid + self.lo[g],
+                                 self.hi[g] - self.lo[g], t.xmin, t.xmax, ymin, ymax, strip)
                 inside = strip
+            else:
+                a = _first_above(xs, self.lo[g], self.hi[g], t.xmin)
+                e = _first_not_below(xs, a, self.hi[g], t.xmax)
+                if ((ymin < edges[band] or ymin == -INFINITY)
+                        and (edges[band + 1] <= ymax or ymax == INFINITY)):
+                    inside = sid + a            # the band lies within the box's y extent
+                    n = e - a
+                else:
+                    n = _compact(ys + a, sid + a, e - a, ymin, ymax, strip)
+                    inside = strip
             for j in range(n):
                 s = inside[j]
                 c = counts[s]
