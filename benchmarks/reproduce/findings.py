@@ -32,11 +32,17 @@ def _fmt(value):
     return f"{value:,.0f}" if abs(value) >= 100 else f"{value:,.3g}"
 
 
-def _missing(claim, stats, labels):
-    absent = [label for label in labels if label not in stats]
-    if absent:
-        return Verdict(claim, None, f"not run: {', '.join(absent)}")
-    return None
+class _Rule:
+    """A claim about some settings: `check` reports the settings not run, else `_judge`s."""
+
+    def _needs(self):
+        return self.labels
+
+    def check(self, stats):
+        absent = [label for label in self._needs() if label not in stats]
+        if absent:
+            return Verdict(self.claim, None, f"not run: {', '.join(absent)}")
+        return self._judge(stats)
 
 
 def _better(a, b):
@@ -53,7 +59,7 @@ def _gap_note(a, b):
 
 
 @dataclass(frozen=True)
-class Ranking:
+class Ranking(_Rule):
     """Every label of group ``i`` scores better than every label of any later group.
 
     Parameters
@@ -67,11 +73,11 @@ class Ranking:
     groups: tuple
     claim: str
 
-    def check(self, stats):
-        labels = [label for group in self.groups for label in group]
-        missing = _missing(self.claim, stats, labels)
-        if missing:
-            return missing
+    def _needs(self):
+        return [label for group in self.groups for label in group]
+
+    def _judge(self, stats):
+        labels = self._needs()
         wrong, noisy = [], []
         for i, upper in enumerate(self.groups):
             for lower in self.groups[i + 1:]:
@@ -93,16 +99,13 @@ class Ranking:
 
 
 @dataclass(frozen=True)
-class Similar:
+class Similar(_Rule):
     """No setting differs from another by more than `_NOISE_SE` combined SEs."""
 
     labels: tuple
     claim: str
 
-    def check(self, stats):
-        missing = _missing(self.claim, stats, self.labels)
-        if missing:
-            return missing
+    def _judge(self, stats):
         items = [stats[label] for label in self.labels]
         worst = max(((a, b) for a in items for b in items),
                     key=lambda p: abs(p[0].score - p[1].score) - _NOISE_SE * math.hypot(
@@ -120,17 +123,17 @@ class Similar:
 
 
 @dataclass(frozen=True)
-class MoreStable:
+class MoreStable(_Rule):
     """`stable` changes less between consecutive iterations than each of `others`."""
 
     stable: str
     others: tuple
     claim: str
 
-    def check(self, stats):
-        missing = _missing(self.claim, stats, (self.stable, *self.others))
-        if missing:
-            return missing
+    def _needs(self):
+        return (self.stable, *self.others)
+
+    def _judge(self, stats):
         values = {label: stats[label].instability for label in (self.stable, *self.others)}
         if any(math.isnan(v) for v in values.values()):
             return Verdict(self.claim, None, "needs at least 2 iterations")
@@ -140,7 +143,7 @@ class MoreStable:
 
 
 @dataclass(frozen=True)
-class Sign:
+class Sign(_Rule):
     """The score of `label` is positive (``positive=True``) or negative, by more than
     `_NOISE_SE` standard errors."""
 
@@ -148,10 +151,10 @@ class Sign:
     positive: bool
     claim: str
 
-    def check(self, stats):
-        missing = _missing(self.claim, stats, (self.label,))
-        if missing:
-            return missing
+    def _needs(self):
+        return (self.label,)
+
+    def _judge(self, stats):
         s = stats[self.label]
         margin = _NOISE_SE * s.score_se
         clear = not math.isnan(margin) and abs(s.score) >= margin
@@ -161,17 +164,17 @@ class Sign:
 
 
 @dataclass(frozen=True)
-class NearRandom:
+class NearRandom(_Rule):
     """`label` scores closer to the random policy than to `reference`."""
 
     label: str
     reference: str
     claim: str
 
-    def check(self, stats):
-        missing = _missing(self.claim, stats, (self.label, self.reference))
-        if missing:
-            return missing
+    def _needs(self):
+        return (self.label, self.reference)
+
+    def _judge(self, stats):
         s, ref = stats[self.label], stats[self.reference]
         holds = abs(s.score - s.random_reward) < abs(ref.score - s.score)
         return Verdict(self.claim, holds,
@@ -180,34 +183,28 @@ class NearRandom:
 
 
 @dataclass(frozen=True)
-class HighestPeak:
+class HighestPeak(_Rule):
     """`label` reaches the best single evaluation among `labels`."""
 
     label: str
     labels: tuple
     claim: str
 
-    def check(self, stats):
-        missing = _missing(self.claim, stats, self.labels)
-        if missing:
-            return missing
+    def _judge(self, stats):
         winner = max(self.labels, key=lambda label: stats[label].best)
         listed = ", ".join(f"{label} {_fmt(stats[label].best)}" for label in self.labels)
         return Verdict(self.claim, winner == self.label, f"best single evaluation: {listed}")
 
 
 @dataclass(frozen=True)
-class Falls:
+class Falls(_Rule):
     """The score improves from the first to the last of `labels` (e.g. RMSE falls as M
     grows)."""
 
     labels: tuple
     claim: str
 
-    def check(self, stats):
-        missing = _missing(self.claim, stats, self.labels)
-        if missing:
-            return missing
+    def _judge(self, stats):
         first, last = stats[self.labels[0]], stats[self.labels[-1]]
         listed = ", ".join(f"{label} {_fmt(stats[label].score)}" for label in self.labels)
         return Verdict(self.claim, _better(last, first),
