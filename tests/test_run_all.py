@@ -246,3 +246,18 @@ def test_report_shows_thesis_numbers_beside_ours_and_computed_verdicts(tmp_path)
     assert "| 3.9 | [sampling](#sampling) | 4/4 | mixed has the higher mean | yes |" in text
     assert (tmp_path / "fig3.9_sampling.png").exists()
     assert "Not run at this budget yet." in text  # the other experiments
+
+
+def test_budget_overrides_reach_every_setting_of_their_experiment_and_its_cache(tmp_path):
+    budget = replace(TINY, overrides={"treasure": {"n_estimators": 1}})
+    units = plan([REGISTRY["treasure"], REGISTRY["sampling"]], budget, tmp_path)
+    trees = {(u.experiment, u.label): u.params["n_estimators"] for u in units}
+    assert {v for (e, _), v in trees.items() if e == "treasure"} == {1}
+    assert {v for (e, _), v in trees.items() if e == "sampling"} == {30}
+    # a run cached without the override is not reused with it
+    unit = next(u for u in units if u.experiment == "treasure")
+    save_unit(unit.path, REGISTRY["treasure"].params(unit.label), budget, unit.samples,
+              "treasure", unit.label, unit.seed, {"rewards": [0.0], "seconds": 1.0})
+    assert load_unit(unit.path, unit.params, budget, unit.samples) is None
+    report = write_outputs([REGISTRY["treasure"]], budget, tmp_path).read_text()
+    assert "`treasure` runs with n_estimators=1 (every setting alike)" in report

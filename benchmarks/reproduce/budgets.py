@@ -3,7 +3,7 @@
 A budget's name is part of every cache path (``<out>/runs/<budget>/...``), so runs of
 different budgets never mix.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 __all__ = ["Budget", "BUDGETS", "EVAL_REFERENCE_STEPS"]
 
@@ -37,6 +37,9 @@ class Budget:
         FQI iterations of the run whose Q-forest the attention figure draws.
     max_trees, max_tests : int or None
         Caps on the forests' M and K (None: the thesis's values).
+    overrides : dict of str to dict
+        Experiment name -> parameters replacing its settings' at this budget (applied to
+        every setting of the experiment alike, so its comparison stays fair).
     """
 
     name: str
@@ -50,6 +53,7 @@ class Budget:
     attention_iterations: int = 3
     max_trees: int = None
     max_tests: int = None
+    overrides: dict = field(default_factory=dict)
 
     @property
     def reward_scale(self):
@@ -60,9 +64,12 @@ class Budget:
 BUDGETS = {
     "full": Budget("full", seeds=5, iterations=20, samples=20_000, eval_steps=20_000,
                    rmse_samples=20_000, rmse_folds=10, attention_iterations=10),
-    # measured: about 15 minutes on 2 cores shared with other jobs (README)
+    # The treasure game's global view holds ~360 objects per state (the local view ~40):
+    # with the thesis's M=30, K=500 its one quick run took 7 of --quick's 22 minutes
+    # (measured), so the quick budget gives all four views of that figure smaller forests.
     "quick": Budget("quick", seeds=1, iterations=5, samples=4_000, eval_steps=8_000,
-                    rmse_samples=5_000, rmse_folds=3, attention_iterations=3),
+                    rmse_samples=5_000, rmse_folds=3, attention_iterations=3,
+                    overrides={"treasure": {"n_estimators": 10, "n_tests": 200}}),
     # for the tests: every experiment end to end in seconds
     "tiny": Budget("tiny", seeds=1, iterations=2, samples=200, eval_steps=50,
                    rmse_samples=200, rmse_folds=2, dqn_steps=100, attention_iterations=1,

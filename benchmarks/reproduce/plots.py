@@ -115,7 +115,7 @@ def _attention(experiment, stats, runs, budget):
     a reference world the agent never trained on."""
     (label, records), = runs.items()
     result = records[0]["result"]
-    params = experiment.params(label)
+    params = experiment.params(label, budget)
     env = gym.make(params["env_id"], render_mode="rgb_array", render_view="local")
     env.reset(seed=result["world_seed"])
     image = env.render()

@@ -67,10 +67,12 @@ class Experiment:
     findings: tuple = ()
     notes: str = ""
 
-    def params(self, label):
-        """Full parameters of a setting (defaults, env and kind filled in)."""
+    def params(self, label, budget=None):
+        """Full parameters of a setting (defaults, env and kind filled in), with the
+        `budget`'s overrides for this experiment applied last."""
+        overrides = {} if budget is None else budget.overrides.get(self.name, {})
         return {"kind": self.kind, "env_id": self.env_id, **self.defaults,
-                **self.settings[label]}
+                **self.settings[label], **overrides}
 
 
 def _axis(name, figure, title, key, values, label, base, **kwargs):

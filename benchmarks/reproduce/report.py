@@ -93,6 +93,9 @@ def _header(experiments, budget, seeds, elapsed, n_run):
         f"CV on {budget.rmse_samples:,} random-policy samples. DQN: {dqn_steps:,} env steps."
         + ("" if budget.max_trees is None else
            f" Forests capped at {budget.max_trees} trees, {budget.max_tests} tests.")
+        + "".join(f" At this budget `{name}` runs with "
+                  + ", ".join(f"{key}={value}" for key, value in params.items())
+                  + " (every setting alike)." for name, params in budget.overrides.items())
         + f"\n\nScores: FQI = mean reward of the last {LAST_WINDOW} iterations (mean over "
         f"runs, +- sd over runs); 'within noise' = the gap is under 2 standard errors of the "
         f"averaged rewards. Verdicts are computed from these numbers by the rules in "

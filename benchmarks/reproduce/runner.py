@@ -43,7 +43,8 @@ class Unit:
                       else budget.iterations)
         actions = 2.0 if p["env_id"] == "ObjectWorldSword-v0" else 1.0
         kept = 3.0 if p.get("keep_data") else 1.0
-        return 0.3 * iterations * self.samples / 1000 * trees * actions * kept
+        objects = 9.0 if p.get("view") == "global" else 1.0  # ~360 objects, not ~40
+        return 0.3 * iterations * self.samples / 1000 * trees * actions * kept * objects
 
 
 def seeds_for(experiment, budget, seeds=None):
@@ -79,7 +80,7 @@ def plan(experiments, budget, out, seeds=None):
             for seed in seeds_for(experiment, budget, seeds):
                 path = unit_path(out, budget, owner.name, owner_label, seed)
                 units.setdefault(path, Unit(owner.name, owner_label, seed,
-                                            owner.params(owner_label), samples, path))
+                                            owner.params(owner_label, budget), samples, path))
     return list(units.values())
 
 
@@ -148,7 +149,7 @@ def gather(experiment, budget, out, seeds=None):
     stats, runs = {}, {}
     for label in experiment.settings:
         owner, owner_label = resolve(experiment, label)
-        params = owner.params(owner_label)
+        params = owner.params(owner_label, budget)
         samples = int(budget.samples * owner.sample_scale)
         records = [load_unit(unit_path(out, budget, owner.name, owner_label, seed), params,
                              budget, samples) for seed in seeds_for(experiment, budget, seeds)]
