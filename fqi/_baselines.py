@@ -1,4 +1,5 @@
 """The regressors compared in the thesis, and stable-baselines3 DQN on the grid observation."""
+import sys
 import time
 from dataclasses import dataclass
 
@@ -144,12 +145,16 @@ def train_dqn(env="ObjectWorld-v0", total_timesteps=400_000, *, n_bins=10, gamma
     """
     import torch
     from stable_baselines3 import DQN
+    from stable_baselines3.common.logger import HumanOutputFormat, Logger
 
     if not isinstance(env, str):
         raise TypeError(f"env must be a registered env id, got {type(env).__name__}")
     train_env = GridObservation(gym.make(env), n_bins=n_bins)
     model = DQN("MlpPolicy", train_env, gamma=gamma, seed=seed, device="cpu",
                 **{**_DQN_DEFAULTS, **dqn_kwargs})
+    if model.tensorboard_log is None:
+        # SB3's own logger would create an unused /tmp/SB3-<time> folder on every call
+        model.set_logger(Logger(None, [HumanOutputFormat(sys.stdout)] if model.verbose else []))
     threads = torch.get_num_threads()
     torch.set_num_threads(torch_threads)
     try:

@@ -1,5 +1,6 @@
 """The FQI agent: SB3-style API, data regimes, determinism, persistence, learning, bad input."""
 import csv
+import tempfile
 
 import gymnasium as gym
 import numpy as np
@@ -247,12 +248,14 @@ def test_grid_observation_reuses_grid_counts():
     assert GridObservation(gym.make("ObjectWorldSword-v0")).action_space.n == 8
 
 
-def test_train_dqn_scores_with_the_same_evaluation():
+def test_train_dqn_scores_with_the_same_evaluation(tmp_path, monkeypatch):
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     result = train_dqn(ENV, total_timesteps=300, eval_steps=500, seed=0, learning_starts=100,
                        policy_kwargs={"net_arch": [16]})
     assert result.model.num_timesteps == 300 and result.total_timesteps == 300
     assert np.isfinite(result.reward) and result.train_seconds > 0
     assert result.reward == evaluate(result.policy, ENV, 500)
+    assert not list(tmp_path.glob("SB3-*"))  # no stray SB3 log folder
 
 
 def test_scripted_policies_use_the_same_evaluation():
