@@ -421,6 +421,7 @@ def _nodes_per_tree(models):
     return float(np.mean(counts)) if counts else np.nan
 
 
+# Not sklearn.utils.check_scalar: it accepts NaN for a bounded float and True for an int.
 def _check_int(name, value, low):
     if not isinstance(value, Integral) or isinstance(value, bool):
         raise TypeError(f"{name} must be an int, got {value!r}")
