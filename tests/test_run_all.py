@@ -246,6 +246,8 @@ def test_report_shows_thesis_numbers_beside_ours_and_computed_verdicts(tmp_path)
     assert "| 3.9 | [sampling](#sampling) | 4/4 | mixed has the higher mean | yes |" in text
     assert (tmp_path / "fig3.9_sampling.png").exists()
     assert "Not run at this budget yet." in text  # the other experiments
+    assert ("| 3.6 | [representations](#representations) | 0/10 | fixed ~ bounded > random box "
+            "> grid > classic | n/a | not run at this budget yet |") in text
 
 
 def test_budget_overrides_reach_every_setting_of_their_experiment_and_its_cache(tmp_path):
