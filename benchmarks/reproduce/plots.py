@@ -7,6 +7,7 @@ import gymnasium as gym  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 import envs  # noqa: E402
 
@@ -63,6 +64,7 @@ def _curves(experiment, stats, runs, budget):
         ax.fill_between(x, mean - sd, mean + sd, alpha=0.2)
     ax.axhline(0, color="grey", lw=0.6)
     ax.set_xlabel("iteration (0: random policy)" if first == 0 else "iteration")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("reward per 20,000 greedy steps")
     ax.set_title(_title(experiment, budget, stats), fontsize=10)
     ax.legend(fontsize=8, title=f"setting (mean of last {LAST_WINDOW} it.)",
