@@ -175,6 +175,7 @@ def test_report_marks_missing_runs_as_partial(tiny_run, tmp_path):
                    "--only", "sampling", "--report-only", "--no-progress"])
     text = report.read_text()
     assert "Partial: 2 of 4 runs finished" in text  # seed 1 never ran
+    assert "This invocation ran" not in text  # a report-only call runs nothing
 
 
 # ------------------------------------------------------------------------------ findings

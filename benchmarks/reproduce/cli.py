@@ -82,6 +82,8 @@ def main(argv=None):
     units = plan(experiments, budget, args.out, args.seeds)
     done = [] if args.report_only else run(units, budget, args.jobs, not args.no_progress)
     elapsed = time.perf_counter() - start
-    report = write_outputs(experiments, budget, args.out, args.seeds, elapsed, len(done))
+    # a report-only invocation ran nothing: its header says so by omitting the timing
+    report = write_outputs(experiments, budget, args.out, args.seeds,
+                           None if args.report_only else elapsed, len(done))
     print(f"\n{len(done)} runs in {elapsed / 60:.1f} min; report: {report}")
     return report
