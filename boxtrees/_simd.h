@@ -81,22 +81,33 @@ static int64_t boxtrees_compact_avx512(const float *ys, const int32_t *sid, int6
 }
 #endif
 
-static boxtrees_compact_box_fn boxtrees_select_compact_box(int allow_simd)
+/* Whether the AVX-512 versions may run: built for x86-64 with GCC/Clang, allowed, and the
+   CPU has AVX-512F. */
+static int boxtrees_use_avx512(int allow_simd)
 {
 #if defined(__GNUC__) && defined(__x86_64__)
     __builtin_cpu_init();
-    if (allow_simd && __builtin_cpu_supports("avx512f"))
+    return allow_simd && __builtin_cpu_supports("avx512f");
+#else
+    (void)allow_simd;
+    return 0;
+#endif
+}
+
+/* The fastest version this CPU runs, or the portable one when `allow_simd` is 0. */
+static boxtrees_compact_box_fn boxtrees_select_compact_box(int allow_simd)
+{
+#if defined(__GNUC__) && defined(__x86_64__)
+    if (boxtrees_use_avx512(allow_simd))
         return boxtrees_compact_box_avx512;
 #endif
     return boxtrees_compact_box_portable;
 }
 
-/* The fastest version this CPU runs, or the portable one when `allow_simd` is 0. */
 static boxtrees_compact_fn boxtrees_select_compact(int allow_simd)
 {
 #if defined(__GNUC__) && defined(__x86_64__)
-    __builtin_cpu_init();
-    if (allow_simd && __builtin_cpu_supports("avx512f"))
+    if (boxtrees_use_avx512(allow_simd))
         return boxtrees_compact_avx512;
 #endif
     return boxtrees_compact_portable;
