@@ -17,8 +17,8 @@ from fqi import FQI, RandomPolicy, evaluate, make_box_forest, make_grid_ridge, t
 __all__ = ["run_unit", "GAMMA"]
 
 # Discount factor of every FQI and DQN run (the thesis does not state one; 0.5 scored best
-# in the measured comparison of README section "fqi"). Pinned here so a changed library default cannot silently
-# change cached results.
+# in the measured comparison of README section "fqi"). Pinned here so a changed library
+# default cannot silently change cached results.
 GAMMA = 0.5
 _TOP_TESTS = 12  # boxes drawn per action in the attention figure
 _ATTENTION_CANDIDATES = 40  # reference worlds searched for a busy view to draw on
