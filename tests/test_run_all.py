@@ -191,6 +191,8 @@ def test_ranking_holds_fails_and_flags_noise():
     assert "c not worse than b" in rule.check({**good, "c": _stats("c", 95)}).explanation
     assert "within noise" in rule.check({**good, "c": _stats("c", 89)}).explanation
     assert rule.check({"a": good["a"]}).holds is None  # settings not run
+    assert rule.check({"a": good["a"]}).explanation == "not run: b, c"
+    assert rule.check({}).explanation == "not run at this budget yet"
 
 
 def test_ranking_lower_is_better_for_rmse():

@@ -5,7 +5,6 @@ import math
 import time
 from pathlib import Path
 
-from .findings import Verdict
 from .plots import ACTION_NAMES, TYPE_NAMES, plot_experiment
 from .registry import EXPERIMENTS
 from .runner import gather, seeds_for
@@ -51,9 +50,7 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
         stats, runs = gather(experiment, budget, out, seeds)
         planned = len(experiment.settings) * len(seeds_for(experiment, budget, seeds))
         done = sum(s.n_runs for s in stats.values())
-        verdicts = [rule.check(stats) if stats else
-                    Verdict(rule.claim, None, "not run at this budget yet")
-                    for rule in experiment.findings]
+        verdicts = [rule.check(stats) for rule in experiment.findings]
         if stats:
             plot_experiment(experiment, stats, runs, budget, out / figure_name(experiment))
             _write_csv(experiment, runs, out / f"{experiment.name}.csv")
