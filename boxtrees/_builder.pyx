@@ -8,7 +8,9 @@ narrow strip, not in the node; bands lying wholly inside the box need no y compa
 and short ranges (deep nodes) are tested whole, x and y at once, with no search.
 Only samples hit by the box get a non-zero count, which is all the threshold draw and the score
 need. Splitting a node partitions every segment range stably, so both children keep their
-objects sorted by x. Nodes are grown depth first from an explicit stack: fixed 2 x 2 boxes make
+objects sorted by x. Samples are numbered by their position in the node order, not by their
+input row, and renumbered at every split, so a node's per-sample arrays (counts, weights,
+targets) are one contiguous range that stays in the fastest cache as nodes shrink. Nodes are grown depth first from an explicit stack: fixed 2 x 2 boxes make
 trees hundreds of levels deep.
 """
 import numpy as np
@@ -141,14 +143,17 @@ cdef class _Splitter:
     cdef coord_t* tmp_y
     cdef int32* tmp_sid
     cdef int32* strip                # sample ids of the objects of a strip inside the box
-    cdef int32* samples
+    cdef int32* order                # scratch of split(): the old id of each new position
+    cdef int32* new_id               # scratch of split(): the new id of each old one
+    cdef float64_t* tmp_value        # scratch of split(): one per-sample array reordered
     cdef int32* counts
     cdef int32* hits
     cdef uint8* goes_right
     cdef intp_t* lo
     cdef intp_t* hi
-    cdef const float64_t* target
-    cdef const float64_t* weight
+    # per sample, indexed by its current id (its position in the node order)
+    cdef float64_t* target
+    cdef float64_t* weight
     cdef float64_t* weighted_target  # weight * target
     cdef double* region              # per type of the current node: x0, x1, y0, y1 of its tests
     cdef intp_t* type_size           # per type: the current node's number of objects
@@ -185,7 +190,9 @@ cdef class _Splitter:
         self.tmp_y = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
         self.tmp_sid = <int32*>self._own(np.empty(max_segment, dtype=np.int32))
         self.strip = <int32*>self._own(np.empty(max_segment + COMPACT_SLACK, dtype=np.int32))
-        self.samples = <int32*>self._own(np.arange(n_samples, dtype=np.int32))
+        self.order = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
+        self.new_id = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
+        self.tmp_value = <float64_t*>self._own(np.empty(n_samples, dtype=np.float64))
         self.counts = <int32*>self._own(np.zeros(n_samples, dtype=np.int32))
         # one spare slot: the branch-free scatter in count() stores a sample id before it
         # knows whether the sample is new, so with every sample hit it writes one past them
@@ -193,10 +200,10 @@ cdef class _Splitter:
         self.goes_right = <uint8*>self._own(np.zeros(n_samples, dtype=np.uint8))
         self.lo = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
         self.hi = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
-        target = np.ascontiguousarray(target, dtype=np.float64)
-        weight = np.ascontiguousarray(weight, dtype=np.float64)
-        self.target = <const float64_t*>self._own(target)
-        self.weight = <const float64_t*>self._own(weight)
+        target = np.array(target, dtype=np.float64)     # own copies: split() reorders them
+        weight = np.array(weight, dtype=np.float64)
+        self.target = <float64_t*>self._own(target)
+        self.weight = <float64_t*>self._own(weight)
         self.weighted_target = <float64_t*>self._own(weight * target)
         self.edges = <const float64_t*>self._own(np.ascontiguousarray(band_edges, dtype=np.float64))
         self.region = <double*>self._own(np.empty(4 * bounds.shape[0], dtype=np.float64))
@@ -423,15 +430,18 @@ cdef class _Splitter:
     cdef intp_t split(self, const BoxTest* best, intp_t* right_lo) noexcept nogil:
         """Send the node's samples and objects left or right; return the first right sample.
 
-        Per segment, the left child's objects end up in ``lo[g]:right_lo[g]`` and the right
-        child's in ``right_lo[g]:hi[g]``, each still sorted by x.
+        The node's samples are renumbered: the left child's become ``start:mid`` and the right
+        child's ``mid:end``. Per segment, the left child's objects end up in
+        ``lo[g]:right_lo[g]`` and the right child's in ``right_lo[g]:hi[g]``, each still
+        sorted by x.
         """
         cdef int32 cmax
         cdef intp_t n_hit = self.count(best, &cmax)
         cdef coord_t* xs = self.xs
         cdef coord_t* ys = self.ys
         cdef int32* sid = self.sid
-        cdef int32* samples = self.samples
+        cdef int32* order = self.order
+        cdef int32* new_id = self.new_id
         cdef uint8* goes_right = self.goes_right
         cdef coord_t* tmp_x = self.tmp_x
         cdef coord_t* tmp_y = self.tmp_y
@@ -442,14 +452,21 @@ cdef class _Splitter:
             s = self.hits[j]
             goes_right[s] = self.counts[s] >= best.threshold
             self.counts[s] = 0
+        for i in range(self.start, self.end):
+            order[i] = <int32>i
         i = self.start
         k = self.end
         while i < k:
-            if goes_right[samples[i]]:
+            if goes_right[order[i]]:
                 k -= 1
-                samples[i], samples[k] = samples[k], samples[i]
+                order[i], order[k] = order[k], order[i]
             else:
                 i += 1
+        for k in range(self.start, self.end):
+            new_id[order[k]] = <int32>k
+        self._reorder(self.target)
+        self._reorder(self.weight)
+        self._reorder(self.weighted_target)
         for g in range(self.n_types * self.n_bands):
             nl = self.lo[g]
             nr = 0
@@ -457,6 +474,7 @@ cdef class _Splitter:
                 # branch-free stable partition: write to both sides, advance one
                 s = sid[k]
                 right = goes_right[s]
+                s = new_id[s]
                 tmp_x[nr] = xs[k]
                 tmp_y[nr] = ys[k]
                 tmp_sid[nr] = s
@@ -474,6 +492,14 @@ cdef class _Splitter:
             goes_right[self.hits[j]] = 0
         return i
 
+    cdef void _reorder(self, float64_t* values) noexcept nogil:
+        """Move the node's entries of a per-sample array to the samples' new ids."""
+        cdef intp_t k
+        for k in range(self.start, self.end):
+            self.tmp_value[k] = values[self.order[k]]
+        for k in range(self.start, self.end):
+            values[k] = self.tmp_value[k]
+
 
 cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segment_ptr,
                 double min_samples_split, intp_t max_depth) noexcept nogil:
@@ -485,7 +511,7 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segme
     cdef StackRecord rec
     cdef Node node
     cdef BoxTest best
-    cdef intp_t g, i, s, base, node_id, mid
+    cdef intp_t g, i, base, node_id, mid
     cdef double w, wy, wy2, y, ymin, ymax
     right_lo.resize(n_segments)
     stack.push_back(StackRecord(0, splitter.n_samples, 0, TREE_LEAF, False))
@@ -506,11 +532,10 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segme
         ymin = INFINITY
         ymax = -INFINITY
         for i in range(rec.start, rec.end):
-            s = splitter.samples[i]
-            y = splitter.target[s]
-            w += splitter.weight[s]
-            wy += splitter.weight[s] * y
-            wy2 += splitter.weight[s] * y * y
+            y = splitter.target[i]
+            w += splitter.weight[i]
+            wy += splitter.weight[i] * y
+            wy2 += splitter.weight[i] * y * y
             ymin = min(ymin, y)
             ymax = max(ymax, y)
         node.left = node.right = TREE_LEAF
