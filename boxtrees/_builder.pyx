@@ -100,32 +100,32 @@ cdef inline intp_t _first_not_below(const coord_t* x, intp_t lo, intp_t hi, coor
 cnp.import_array()
 
 cdef extern from "_simd.h":
-    ctypedef intp_t (*boxtrees_compact_fn)(const coord_t* ys, const int32* sid, intp_t n,
-                                           coord_t ymin, coord_t ymax, int32* out) noexcept nogil
-    boxtrees_compact_fn boxtrees_select_compact(int allow_simd) noexcept nogil
-    ctypedef intp_t (*boxtrees_compact_box_fn)(const coord_t* xs, const coord_t* ys,
-                                               const int32* sid, intp_t n, coord_t xmin,
-                                               coord_t xmax, coord_t ymin, coord_t ymax,
-                                               int32* out) noexcept nogil
-    boxtrees_compact_box_fn boxtrees_select_compact_box(int allow_simd) noexcept nogil
+    ctypedef struct boxtrees_kernels:
+        intp_t (*compact)(const coord_t* ys, const int32* sid, intp_t n, coord_t ymin,
+                          coord_t ymax, int32* out) noexcept nogil
+        intp_t (*compact_box)(const coord_t* xs, const coord_t* ys, const int32* sid, intp_t n,
+                              coord_t xmin, coord_t xmax, coord_t ymin, coord_t ymax,
+                              int32* out) noexcept nogil
+        intp_t (*partition)(coord_t* xs, coord_t* ys, int32* sid, intp_t n,
+                            const int32* new_id, int32 mid, coord_t* tmp_x, coord_t* tmp_y,
+                            int32* tmp_sid) noexcept nogil
+    boxtrees_kernels boxtrees_select_kernels(int allow_simd) noexcept nogil
 
 cdef enum:
     SHORT_SEGMENT = 160  # segments up to this long are scanned whole instead of searched
-    COMPACT_SLACK = 16  # spare slots the SIMD compaction may write past its count
+    SIMD_SLACK = 16  # spare slots the SIMD kernels may write past their count
 
-# the strip compaction used by every tree (see _simd.h)
-cdef boxtrees_compact_fn _compact = boxtrees_select_compact(1)
-cdef boxtrees_compact_box_fn _compact_box = boxtrees_select_compact_box(1)
+# the data-parallel kernels used by every tree (see _simd.h)
+cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)
 
 
 def _set_simd(bint enabled):
-    """Use the SIMD strip compaction when the CPU has it (default) or the portable one.
+    """Use the SIMD kernels when the CPU has them (default) or the portable ones.
 
     Both give identical trees; this switch exists to test that.
     """
-    global _compact, _compact_box
-    _compact = boxtrees_select_compact(enabled)
-    _compact_box = boxtrees_select_compact_box(enabled)
+    global _kernels
+    _kernels = boxtrees_select_kernels(enabled)
 
 
 cdef class _Splitter:
@@ -186,10 +186,10 @@ cdef class _Splitter:
         self.ys = <coord_t*>self._own(np.array(y, dtype=np.float32))
         self.sid = <int32*>self._own(np.array(sample_of, dtype=np.int32))
         # scratch for one segment at a time: its right-going objects, or a strip's hits
-        self.tmp_x = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
-        self.tmp_y = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
-        self.tmp_sid = <int32*>self._own(np.empty(max_segment, dtype=np.int32))
-        self.strip = <int32*>self._own(np.empty(max_segment + COMPACT_SLACK, dtype=np.int32))
+        self.tmp_x = <coord_t*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.float32))
+        self.tmp_y = <coord_t*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.float32))
+        self.tmp_sid = <int32*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.int32))
+        self.strip = <int32*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.int32))
         self.order = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
         self.new_id = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
         self.tmp_value = <float64_t*>self._own(np.empty(n_samples, dtype=np.float64))
@@ -316,7 +316,7 @@ cdef class _Splitter:
             g = t.object_type * self.n_bands + band
             if self.hi[g] - self.lo[g] <= SHORT_SEGMENT:
                 # a short segment is tested whole, x and y at once: no search
-                n = _compact_box(xs + self.lo[g], ys + self.lo[g], sid + self.lo[g],
+                n = _kernels.compact_box(xs + self.lo[g], ys + self.lo[g], sid + self.lo[g],
                                  self.hi[g] - self.lo[g], t.xmin, t.xmax, ymin, ymax, strip)
                 inside = strip
             else:
@@ -327,7 +327,7 @@ cdef class _Splitter:
                     inside = sid + a            # the band lies within the box's y extent
                     n = e - a
                 else:
-                    n = _compact(ys + a, sid + a, e - a, ymin, ymax, strip)
+                    n = _kernels.compact(ys + a, sid + a, e - a, ymin, ymax, strip)
                     inside = strip
             for j in range(n):
                 s = inside[j]
@@ -437,16 +437,9 @@ cdef class _Splitter:
         """
         cdef int32 cmax
         cdef intp_t n_hit = self.count(best, &cmax)
-        cdef coord_t* xs = self.xs
-        cdef coord_t* ys = self.ys
-        cdef int32* sid = self.sid
         cdef int32* order = self.order
-        cdef int32* new_id = self.new_id
         cdef uint8* goes_right = self.goes_right
-        cdef coord_t* tmp_x = self.tmp_x
-        cdef coord_t* tmp_y = self.tmp_y
-        cdef int32* tmp_sid = self.tmp_sid
-        cdef intp_t i, j, k, g, nl, nr, right
+        cdef intp_t i, j, k, g
         cdef int32 s
         for j in range(n_hit):
             s = self.hits[j]
@@ -463,31 +456,15 @@ cdef class _Splitter:
             else:
                 i += 1
         for k in range(self.start, self.end):
-            new_id[order[k]] = <int32>k
+            self.new_id[order[k]] = <int32>k
         self._reorder(self.target)
         self._reorder(self.weight)
         self._reorder(self.weighted_target)
         for g in range(self.n_types * self.n_bands):
-            nl = self.lo[g]
-            nr = 0
-            for k in range(self.lo[g], self.hi[g]):
-                # branch-free stable partition: write to both sides, advance one
-                s = sid[k]
-                right = goes_right[s]
-                s = new_id[s]
-                tmp_x[nr] = xs[k]
-                tmp_y[nr] = ys[k]
-                tmp_sid[nr] = s
-                xs[nl] = xs[k]
-                ys[nl] = ys[k]
-                sid[nl] = s
-                nr += right
-                nl += 1 - right
-            right_lo[g] = nl
-            for k in range(nr):
-                xs[nl + k] = tmp_x[k]
-                ys[nl + k] = tmp_y[k]
-                sid[nl + k] = tmp_sid[k]
+            right_lo[g] = self.lo[g] + _kernels.partition(
+                self.xs + self.lo[g], self.ys + self.lo[g], self.sid + self.lo[g],
+                self.hi[g] - self.lo[g], self.new_id, <int32>i, self.tmp_x, self.tmp_y,
+                self.tmp_sid)
         for j in range(n_hit):
             goes_right[self.hits[j]] = 0
         return i

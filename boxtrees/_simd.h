@@ -1,21 +1,35 @@
-/* Compaction of a strip: the sample ids of the objects whose y lies in (ymin, ymax), or,
- * for a whole short run, whose (x, y) lies in the open box.
+/* The data-parallel kernels of the tree builder, each in a portable and an AVX-512 version.
  *
- * The portable version is a branch-free scalar loop. On x86-64 CPUs with AVX-512F (checked at
- * run time, so the default build stays portable) sixteen objects are tested and compressed per
- * step. Both write exactly the same ids; the AVX-512 version may write up to 16 slots past the
- * returned count, so `out` needs 16 spare slots.
+ * - compact: the sample ids of a strip's objects whose y lies in (ymin, ymax);
+ * - compact_box: the same for a whole short run, x tested too, so no search is needed;
+ * - partition: renumber a run's sample ids and move, stably, the objects of the left child's
+ *   samples (new id < mid) before those of the right child's.
+ *
+ * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
+ * run time, so the default build stays portable) sixteen objects are handled per step. Both
+ * versions write exactly the same results; the AVX-512 ones may write up to 16 slots past the
+ * returned count of `out`, and of the partition's scratch arrays, so those need 16 spare slots.
  */
 #ifndef BOXTREES_SIMD_H
 #define BOXTREES_SIMD_H
 
 #include <stdint.h>
+#include <string.h>
 
 typedef int64_t (*boxtrees_compact_fn)(const float *ys, const int32_t *sid, int64_t n,
                                        float ymin, float ymax, int32_t *out);
 typedef int64_t (*boxtrees_compact_box_fn)(const float *xs, const float *ys, const int32_t *sid,
                                            int64_t n, float xmin, float xmax, float ymin,
                                            float ymax, int32_t *out);
+typedef int64_t (*boxtrees_partition_fn)(float *xs, float *ys, int32_t *sid, int64_t n,
+                                         const int32_t *new_id, int32_t mid, float *tmp_x,
+                                         float *tmp_y, int32_t *tmp_sid);
+
+typedef struct {
+    boxtrees_compact_fn compact;
+    boxtrees_compact_box_fn compact_box;
+    boxtrees_partition_fn partition;
+} boxtrees_kernels;
 
 static int64_t boxtrees_compact_portable(const float *ys, const int32_t *sid, int64_t n,
                                          float ymin, float ymax, int32_t *out)
@@ -28,7 +42,6 @@ static int64_t boxtrees_compact_portable(const float *ys, const int32_t *sid, in
     return k;
 }
 
-/* The same for a whole short run: x tested too, so no search is needed. */
 static int64_t boxtrees_compact_box_portable(const float *xs, const float *ys, const int32_t *sid,
                                              int64_t n, float xmin, float xmax, float ymin,
                                              float ymax, int32_t *out)
@@ -39,6 +52,51 @@ static int64_t boxtrees_compact_box_portable(const float *xs, const float *ys, c
         k += (xs[j] > xmin) & (xs[j] < xmax) & (ys[j] > ymin) & (ys[j] < ymax);
     }
     return k;
+}
+
+/* Partition objects j..n-1 of a run whose first j objects are done: left ones go to
+   [*nl, ...) of the run itself (never past j), right ones to [*nr, ...) of the scratch. */
+static void boxtrees_partition_from(float *xs, float *ys, int32_t *sid, int64_t j, int64_t n,
+                                    const int32_t *new_id, int32_t mid, float *tmp_x,
+                                    float *tmp_y, int32_t *tmp_sid, int64_t *nl, int64_t *nr)
+{
+    int64_t l = *nl, r = *nr;
+    for (; j < n; j++) {
+        /* branch-free: write to both sides, advance one */
+        int32_t s = new_id[sid[j]];
+        int64_t right = s >= mid;
+        tmp_x[r] = xs[j];
+        tmp_y[r] = ys[j];
+        tmp_sid[r] = s;
+        xs[l] = xs[j];
+        ys[l] = ys[j];
+        sid[l] = s;
+        r += right;
+        l += 1 - right;
+    }
+    *nl = l;
+    *nr = r;
+}
+
+/* Append the right-going objects gathered in the scratch after the left ones; return where
+   they start. */
+static int64_t boxtrees_partition_finish(float *xs, float *ys, int32_t *sid, int64_t nl,
+                                         int64_t nr, const float *tmp_x, const float *tmp_y,
+                                         const int32_t *tmp_sid)
+{
+    memcpy(xs + nl, tmp_x, nr * sizeof(float));
+    memcpy(ys + nl, tmp_y, nr * sizeof(float));
+    memcpy(sid + nl, tmp_sid, nr * sizeof(int32_t));
+    return nl;
+}
+
+static int64_t boxtrees_partition_portable(float *xs, float *ys, int32_t *sid, int64_t n,
+                                           const int32_t *new_id, int32_t mid, float *tmp_x,
+                                           float *tmp_y, int32_t *tmp_sid)
+{
+    int64_t nl = 0, nr = 0;
+    boxtrees_partition_from(xs, ys, sid, 0, n, new_id, mid, tmp_x, tmp_y, tmp_sid, &nl, &nr);
+    return boxtrees_partition_finish(xs, ys, sid, nl, nr, tmp_x, tmp_y, tmp_sid);
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -79,38 +137,55 @@ static int64_t boxtrees_compact_avx512(const float *ys, const int32_t *sid, int6
     }
     return k + boxtrees_compact_portable(ys + j, sid + j, n - j, ymin, ymax, out + k);
 }
+
+/* Whole 16-lane stores into the run are safe: the left count never passes the objects
+   already loaded. The last partial block is left to the scalar loop, so nothing past the run
+   is written. */
+__attribute__((target("avx512f")))
+static int64_t boxtrees_partition_avx512(float *xs, float *ys, int32_t *sid, int64_t n,
+                                         const int32_t *new_id, int32_t mid, float *tmp_x,
+                                         float *tmp_y, int32_t *tmp_sid)
+{
+    const __m512i first_right = _mm512_set1_epi32(mid);
+    int64_t j = 0, nl = 0, nr = 0;
+    for (; j + 16 <= n; j += 16) {
+        /* the masked form: GCC warns that the plain gather reads an undefined register */
+        __m512i s = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), (__mmask16)0xFFFF,
+                                                _mm512_loadu_si512((const void *)(sid + j)),
+                                                (const void *)new_id, 4);
+        __mmask16 right = _mm512_cmpge_epi32_mask(s, first_right);
+        __mmask16 left = (__mmask16)~right;
+        __m512 x = _mm512_loadu_ps(xs + j), y = _mm512_loadu_ps(ys + j);
+        _mm512_storeu_ps(tmp_x + nr, _mm512_maskz_compress_ps(right, x));
+        _mm512_storeu_ps(tmp_y + nr, _mm512_maskz_compress_ps(right, y));
+        _mm512_storeu_si512((void *)(tmp_sid + nr), _mm512_maskz_compress_epi32(right, s));
+        _mm512_storeu_ps(xs + nl, _mm512_maskz_compress_ps(left, x));
+        _mm512_storeu_ps(ys + nl, _mm512_maskz_compress_ps(left, y));
+        _mm512_storeu_si512((void *)(sid + nl), _mm512_maskz_compress_epi32(left, s));
+        nr += __builtin_popcount((unsigned)right);
+        nl += 16 - __builtin_popcount((unsigned)right);
+    }
+    boxtrees_partition_from(xs, ys, sid, j, n, new_id, mid, tmp_x, tmp_y, tmp_sid, &nl, &nr);
+    return boxtrees_partition_finish(xs, ys, sid, nl, nr, tmp_x, tmp_y, tmp_sid);
+}
 #endif
 
-/* Whether the AVX-512 versions may run: built for x86-64 with GCC/Clang, allowed, and the
-   CPU has AVX-512F. */
-static int boxtrees_use_avx512(int allow_simd)
+/* The fastest kernels this CPU runs, or the portable ones when `allow_simd` is 0. */
+static boxtrees_kernels boxtrees_select_kernels(int allow_simd)
 {
+    boxtrees_kernels k = {boxtrees_compact_portable, boxtrees_compact_box_portable,
+                          boxtrees_partition_portable};
 #if defined(__GNUC__) && defined(__x86_64__)
     __builtin_cpu_init();
-    return allow_simd && __builtin_cpu_supports("avx512f");
+    if (allow_simd && __builtin_cpu_supports("avx512f")) {
+        k.compact = boxtrees_compact_avx512;
+        k.compact_box = boxtrees_compact_box_avx512;
+        k.partition = boxtrees_partition_avx512;
+    }
 #else
     (void)allow_simd;
-    return 0;
 #endif
-}
-
-/* The fastest version this CPU runs, or the portable one when `allow_simd` is 0. */
-static boxtrees_compact_box_fn boxtrees_select_compact_box(int allow_simd)
-{
-#if defined(__GNUC__) && defined(__x86_64__)
-    if (boxtrees_use_avx512(allow_simd))
-        return boxtrees_compact_box_avx512;
-#endif
-    return boxtrees_compact_box_portable;
-}
-
-static boxtrees_compact_fn boxtrees_select_compact(int allow_simd)
-{
-#if defined(__GNUC__) && defined(__x86_64__)
-    if (boxtrees_use_avx512(allow_simd))
-        return boxtrees_compact_avx512;
-#endif
-    return boxtrees_compact_portable;
+    return k;
 }
 
 #endif
