@@ -15,6 +15,7 @@ trees hundreds of levels deep.
 """
 import numpy as np
 
+cimport cython
 cimport numpy as cnp
 
 from libc.math cimport INFINITY
@@ -128,6 +129,7 @@ def _set_simd(bint enabled):
     _kernels = boxtrees_select_kernels(enabled)
 
 
+@cython.final
 cdef class _Splitter:
     """Draws, scores and applies the box tests of the node being split.
 
