@@ -64,38 +64,31 @@ cdef struct StackRecord:
     bint is_left
 
 
-# Searches in sorted coordinates: branch-free halving (the comparison compiles to a conditional
-# move; the positions searched are random, so a branchy search would mispredict half of its
-# steps) down to a short run, which a vectorisable count finishes.
+# The x strip of a box in a segment sorted by x: two branch-free halving searches run side by
+# side (the comparisons compile to conditional moves; the positions searched are random, so a
+# branchy search would mispredict half of its steps, and the two independent chains overlap
+# in the CPU), down to a short run that a vectorisable count finishes.
 
 cdef enum:
     LINEAR_RUN = 32
 
 
-cdef inline intp_t _first_above(const coord_t* x, intp_t lo, intp_t hi, coord_t v) noexcept nogil:
-    """First index in [lo, hi) of sorted ``x`` with x > v (hi if none)."""
-    cdef const coord_t* base = x + lo
-    cdef intp_t n = hi - lo, half, i, below = 0
+cdef inline void _strip(const coord_t* x, intp_t lo, intp_t hi, coord_t xmin, coord_t xmax,
+                        intp_t* first, intp_t* end) noexcept nogil:
+    """``x[first:end]`` are the values in (xmin, xmax) of sorted ``x[lo:hi]``."""
+    cdef const coord_t* above = x + lo      # searches the first x > xmin
+    cdef const coord_t* beyond = x + lo     # searches the first x >= xmax
+    cdef intp_t n = hi - lo, half, i, a = 0, e = 0
     while n > LINEAR_RUN:
         half = n >> 1
-        base = base + half if base[half] <= v else base
+        above = above + half if above[half] <= xmin else above
+        beyond = beyond + half if beyond[half] < xmax else beyond
         n -= half
     for i in range(n):
-        below += base[i] <= v
-    return (base - x) + below
-
-
-cdef inline intp_t _first_not_below(const coord_t* x, intp_t lo, intp_t hi, coord_t v) noexcept nogil:
-    """First index in [lo, hi) of sorted ``x`` with x >= v (hi if none)."""
-    cdef const coord_t* base = x + lo
-    cdef intp_t n = hi - lo, half, i, below = 0
-    while n > LINEAR_RUN:
-        half = n >> 1
-        base = base + half if base[half] < v else base
-        n -= half
-    for i in range(n):
-        below += base[i] < v
-    return (base - x) + below
+        a += above[i] <= xmin
+        e += beyond[i] < xmax
+    first[0] = (above - x) + a
+    end[0] = max((beyond - x) + e, first[0])
 
 
 cnp.import_array()
@@ -322,8 +315,7 @@ cdef class _Splitter:
                                  self.hi[g] - self.lo[g], t.xmin, t.xmax, ymin, ymax, strip)
                 inside = strip
             else:
-                a = _first_above(xs, self.lo[g], self.hi[g], t.xmin)
-                e = _first_not_below(xs, a, self.hi[g], t.xmax)
+                _strip(xs, self.lo[g], self.hi[g], t.xmin, t.xmax, &a, &e)
                 if ((ymin < edges[band] or ymin == -INFINITY)
                         and (edges[band + 1] <= ymax or ymax == INFINITY)):
                     inside = sid + a            # the band lies within the box's y extent
@@ -385,8 +377,7 @@ cdef class _Splitter:
         cdef intp_t lo = self.lo[t.object_type], hi = self.hi[t.object_type], a, e, k
         cdef const int32* sid = self.sid
         cdef double w_in = 0.0, wy_in = 0.0, wr, wyr, wl, wyl
-        a = _first_above(self.xs, lo, hi, t.xmin)
-        e = _first_not_below(self.xs, a, hi, t.xmax)
+        _strip(self.xs, lo, hi, t.xmin, t.xmax, &a, &e)
         if e == a or e - a == hi - lo:
             return False
         t.threshold = 1 + <int32>rand_int(&self.rng, 1)   # the draw keeps evaluate's sequence
