@@ -303,16 +303,18 @@ cdef class _Splitter:
         cdef int32* hits = self.hits
         cdef const float64_t* edges = self.edges
         cdef coord_t ymin = t.ymin, ymax = t.ymax
-        cdef intp_t band, g, a, e, j, n, n_hit = 0
+        cdef intp_t band, g, a, e, j, n, n_hit = 0, first_band = 0, end_band = 0
         cdef int32 s, c, top = 0
-        for band in range(self.n_bands):
-            if edges[band + 1] <= ymin or edges[band] >= ymax:
-                continue
+        for band in range(self.n_bands):         # the bands the box overlaps, without branches
+            first_band += edges[band + 1] <= ymin
+            end_band += edges[band] < ymax
+        for band in range(first_band, end_band):
             g = t.object_type * self.n_bands + band
             if self.hi[g] - self.lo[g] <= SHORT_SEGMENT:
                 # a short segment is tested whole, x and y at once: no search
                 n = _kernels.compact_box(xs + self.lo[g], ys + self.lo[g], sid + self.lo[g],
-                                 self.hi[g] - self.lo[g], t.xmin, t.xmax, ymin, ymax, strip)
+                                         self.hi[g] - self.lo[g], t.xmin, t.xmax, ymin, ymax,
+                                         strip)
                 inside = strip
             else:
                 _strip(xs, self.lo[g], self.hi[g], t.xmin, t.xmax, &a, &e)
