@@ -4,26 +4,43 @@ The objects of each sample come grouped by type (``boxtrees._rows.group_by_type`
 test scans only the sample's objects of the tested type. A node's
 test is one 32-byte record (half a cache line) and a left child follows its parent, so a
 root-to-leaf walk touches few cache lines. Samples are processed in blocks, tree by tree, so
-that a tree's nodes stay in cache across a block.
+that a tree's nodes stay in cache across a block. The walk itself is a kernel of ``_simd.h``:
+with AVX-512 it tests all of a sample's objects of a type at once.
 """
-import numpy as np
+cimport numpy as cnp
 
-from ._utils cimport TREE_LEAF, coord_t, float64_t, int32, intp_t
+from ._utils cimport coord_t, float64_t, intp_t
+
+cdef extern from "_simd.h":
+    ctypedef struct boxtrees_node:     # the layout of boxtrees._tree.NODE_DTYPE
+        pass
+    ctypedef struct boxtrees_kernels:
+        intp_t (*find_leaf)(const boxtrees_node* nodes, const coord_t* x, const coord_t* y,
+                            const intp_t* types) noexcept nogil
+    boxtrees_kernels boxtrees_select_kernels(int allow_simd) noexcept nogil
+
+cnp.import_array()
 
 cdef enum:
     BLOCK = 64
 
+# the traversal kernel (see _simd.h)
+cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)
+# what empty object arrays point to: the kernels read nothing through it
+cdef coord_t _NO_OBJECT = 0
 
-cdef packed struct PackedNode:   # the layout of boxtrees._tree.NODE_DTYPE
-    int32 left                   # tree-local child ids
-    int32 right
-    int32 object_type
-    int32 threshold
-    coord_t box[4]
+
+def _set_simd(bint enabled):
+    """Use the SIMD traversal when the CPU has it (default) or the portable one.
+
+    Both give identical results; this switch exists to test that.
+    """
+    global _kernels
+    _kernels = boxtrees_select_kernels(enabled)
 
 
 cdef struct ForestView:
-    const PackedNode* nodes
+    const boxtrees_node* nodes
     const intp_t* tree_offsets   # first node of each tree in the packed arrays
     intp_t n_trees
 
@@ -35,38 +52,19 @@ cdef struct SampleView:
     intp_t stride                # n_types + 1
 
 
-cdef inline intp_t _find_leaf(const ForestView* f, const SampleView* s, intp_t tree,
-                              intp_t i) noexcept nogil:
-    """Tree-local index of the leaf that sample ``i`` reaches in ``tree``."""
-    cdef const PackedNode* nodes = f.nodes + f.tree_offsets[tree]
-    cdef const PackedNode* n = nodes
-    cdef const intp_t* types = s.type_ptr + i * s.stride
-    cdef intp_t k, k_end
-    cdef int32 count
-    while n.left != TREE_LEAF:
-        k = types[n.object_type]
-        k_end = types[n.object_type + 1]
-        count = 0
-        while k < k_end:                # branch-free: a sample has few objects of a type
-            count += ((s.x[k] > n.box[0]) & (s.x[k] < n.box[1])
-                      & (s.y[k] > n.box[2]) & (s.y[k] < n.box[3]))
-            k += 1
-        n = nodes + (n.left if count < n.threshold else n.right)
-    return n - nodes
-
-
 cdef inline void _views(ForestView* f, SampleView* s, forest, samples):
-    cdef const PackedNode[::1] nodes = forest.nodes
+    cdef cnp.ndarray nodes = forest.nodes
     cdef const intp_t[::1] tree_offsets = forest.tree_offsets
     cdef const coord_t[::1] x = samples[0]
     cdef const coord_t[::1] y = samples[1]
     cdef const intp_t[:, ::1] type_ptr = samples[2]
-    f.nodes = &nodes[0]
+    if not (cnp.PyArray_IS_C_CONTIGUOUS(nodes) and nodes.itemsize == sizeof(boxtrees_node)):
+        raise ValueError("forest.nodes must be a C-contiguous array of NODE_DTYPE records")
+    f.nodes = <const boxtrees_node*>cnp.PyArray_DATA(nodes)
     f.tree_offsets = &tree_offsets[0]
     f.n_trees = tree_offsets.shape[0] - 1
-    # an empty batch of objects still needs valid pointers; nothing is read through them
-    s.x = &x[0] if x.shape[0] else NULL
-    s.y = &y[0] if y.shape[0] else NULL
+    s.x = &x[0] if x.shape[0] else &_NO_OBJECT
+    s.y = &y[0] if y.shape[0] else &_NO_OBJECT
     s.type_ptr = &type_ptr[0, 0] if type_ptr.shape[0] else NULL
     s.stride = type_ptr.shape[1]
 
@@ -86,7 +84,8 @@ cdef void _walk(const ForestView* f, const SampleView* s, intp_t start, intp_t s
                 mean[i] = 0.0
         for tree in range(n_trees):
             for i in range(block, block_end):
-                leaf = _find_leaf(f, s, tree, i)
+                leaf = _kernels.find_leaf(f.nodes + f.tree_offsets[tree], s.x, s.y,
+                                          s.type_ptr + i * s.stride)
                 if mean != NULL:
                     mean[i] += value[f.tree_offsets[tree] + leaf]
                 else:

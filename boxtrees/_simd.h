@@ -1,9 +1,12 @@
-/* The data-parallel kernels of the tree builder, each in a portable and an AVX-512 version.
+/* The data-parallel kernels of the tree builder and of the traversal, each in a portable and
+ * an AVX-512 version.
  *
  * - compact: the sample ids of a strip's objects whose y lies in (ymin, ymax);
  * - compact_box: the same for a whole short run, x tested too, so no search is needed;
  * - partition: renumber a run's sample ids and move, stably, the objects of the left child's
- *   samples (new id < mid) before those of the right child's.
+ *   samples (new id < mid) before those of the right child's;
+ * - find_leaf: walk one sample down one tree (the AVX-512 version tests up to sixteen of the
+ *   sample's objects of a type at once, with no loop to mispredict).
  *
  * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
  * run time, so the default build stays portable) sixteen objects are handled per step. Both
@@ -25,10 +28,27 @@ typedef int64_t (*boxtrees_partition_fn)(float *xs, float *ys, int32_t *sid, int
                                          const int32_t *new_id, int32_t mid, float *tmp_x,
                                          float *tmp_y, int32_t *tmp_sid);
 
+
+/* A node test as the traversal reads it (boxtrees._tree.NODE_DTYPE): child ids local to the
+   tree, left = -1 at a leaf (TREE_LEAF). */
+typedef struct {
+    int32_t left;
+    int32_t right;
+    int32_t object_type;
+    int32_t threshold;
+    float box[4];
+} boxtrees_node;
+
+/* The tree-local leaf a sample reaches from root `nodes`; its objects of type t are
+   x[types[t]:types[t + 1]], and likewise y. */
+typedef int64_t (*boxtrees_find_leaf_fn)(const boxtrees_node *nodes, const float *x,
+                                         const float *y, const int64_t *types);
+
 typedef struct {
     boxtrees_compact_fn compact;
     boxtrees_compact_box_fn compact_box;
     boxtrees_partition_fn partition;
+    boxtrees_find_leaf_fn find_leaf;
 } boxtrees_kernels;
 
 static int64_t boxtrees_compact_portable(const float *ys, const int32_t *sid, int64_t n,
@@ -97,6 +117,19 @@ static int64_t boxtrees_partition_portable(float *xs, float *ys, int32_t *sid, i
     int64_t nl = 0, nr = 0;
     boxtrees_partition_from(xs, ys, sid, 0, n, new_id, mid, tmp_x, tmp_y, tmp_sid, &nl, &nr);
     return boxtrees_partition_finish(xs, ys, sid, nl, nr, tmp_x, tmp_y, tmp_sid);
+}
+
+static int64_t boxtrees_find_leaf_portable(const boxtrees_node *nodes, const float *x,
+                                           const float *y, const int64_t *types)
+{
+    const boxtrees_node *n = nodes;
+    while (n->left != -1) {
+        int32_t count = 0;
+        for (int64_t k = types[n->object_type]; k < types[n->object_type + 1]; k++)
+            count += (x[k] > n->box[0]) & (x[k] < n->box[1]) & (y[k] > n->box[2]) & (y[k] < n->box[3]);
+        n = nodes + (count < n->threshold ? n->left : n->right);
+    }
+    return n - nodes;
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -168,19 +201,43 @@ static int64_t boxtrees_partition_avx512(float *xs, float *ys, int32_t *sid, int
     boxtrees_partition_from(xs, ys, sid, j, n, new_id, mid, tmp_x, tmp_y, tmp_sid, &nl, &nr);
     return boxtrees_partition_finish(xs, ys, sid, nl, nr, tmp_x, tmp_y, tmp_sid);
 }
+
+__attribute__((target("avx512f")))
+static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes, const float *x,
+                                         const float *y, const int64_t *types)
+{
+    const boxtrees_node *n = nodes;
+    while (n->left != -1) {
+        int64_t k = types[n->object_type], end = types[n->object_type + 1];
+        int32_t count = 0;
+        do {    /* once for up to 16 objects, none included */
+            __mmask16 live = end - k >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << (end - k)) - 1u);
+            __m512 xs = _mm512_maskz_loadu_ps(live, x + k), ys = _mm512_maskz_loadu_ps(live, y + k);
+            __mmask16 in = live & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[0]), _CMP_GT_OQ)
+                           & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[1]), _CMP_LT_OQ)
+                           & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[2]), _CMP_GT_OQ)
+                           & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[3]), _CMP_LT_OQ);
+            count += __builtin_popcount((unsigned)in);
+            k += 16;
+        } while (k < end);
+        n = nodes + (count < n->threshold ? n->left : n->right);
+    }
+    return n - nodes;
+}
 #endif
 
 /* The fastest kernels this CPU runs, or the portable ones when `allow_simd` is 0. */
 static boxtrees_kernels boxtrees_select_kernels(int allow_simd)
 {
     boxtrees_kernels k = {boxtrees_compact_portable, boxtrees_compact_box_portable,
-                          boxtrees_partition_portable};
+                          boxtrees_partition_portable, boxtrees_find_leaf_portable};
 #if defined(__GNUC__) && defined(__x86_64__)
     __builtin_cpu_init();
     if (allow_simd && __builtin_cpu_supports("avx512f")) {
         k.compact = boxtrees_compact_avx512;
         k.compact_box = boxtrees_compact_box_avx512;
         k.partition = boxtrees_partition_avx512;
+        k.find_leaf = boxtrees_find_leaf_avx512;
     }
 #else
     (void)allow_simd;

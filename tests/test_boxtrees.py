@@ -33,16 +33,28 @@ def reference_leaf(tree, objects):
     return node
 
 
+@pytest.fixture(params=[True, False], ids=["simd", "portable"])
+def traversal_kernel(request):
+    """Run the test with the SIMD traversal kernel (when the CPU has it) and the portable one."""
+    from boxtrees import _predictor
+
+    _predictor._set_simd(request.param)
+    yield
+    _predictor._set_simd(True)
+
+
 @pytest.mark.parametrize("test_type", TEST_TYPES)
-def test_predict_matches_numpy_reference_traversal(test_type):
+def test_predict_matches_numpy_reference_traversal(test_type, traversal_kernel):
     rng = np.random.default_rng(0)
     X, y = random_sets(rng, 400), rng.normal(size=400)
     forest = BoxExtraTreesRegressor(
         n_estimators=7, n_tests=20, min_samples_split=4, test_type=test_type,
         test_width=1.5, random_state=0,
     ).fit(X, y)
-    # unseen type 9 at predict time must match no test
-    X_new = random_sets(rng, 300, n_types=10) + [np.empty((0, 3))]
+    # unseen type 9 at predict time must match no test; sets with more objects of a type than
+    # the SIMD kernel tests at once (16)
+    X_new = (random_sets(rng, 300, n_types=10) + [np.empty((0, 3))]
+             + random_sets(rng, 50, max_objects=80, n_types=2))
     leaves = np.array([[reference_leaf(t, s) for t in forest.estimators_] for s in X_new])
     expected = np.mean(
         [[t.value[leaf] for t, leaf in zip(forest.estimators_, row)] for row in leaves], axis=1
@@ -197,7 +209,7 @@ def test_max_depth_limits_trees():
     assert max(t.max_depth for t in forest.estimators_) == 3
 
 
-def test_simd_and_portable_strip_compaction_grow_identical_trees():
+def test_simd_and_portable_kernels_grow_identical_trees():
     from boxtrees import _builder
 
     X, y = make_box_regression(1500, random_state=0)
