@@ -10,8 +10,9 @@ Only samples hit by the box get a non-zero count, which is all the threshold dra
 need. Splitting a node partitions every segment range stably, so both children keep their
 objects sorted by x. Samples are numbered by their position in the node order, not by their
 input row, and renumbered at every split, so a node's per-sample arrays (counts, weights,
-targets) are one contiguous range that stays in the fastest cache as nodes shrink. Nodes are grown depth first from an explicit stack: fixed 2 x 2 boxes make
-trees hundreds of levels deep.
+targets) are one contiguous range that stays in the fastest cache as nodes shrink. Nodes are
+grown depth first from an explicit stack: fixed 2 x 2 boxes make trees hundreds of levels
+deep.
 """
 import numpy as np
 
