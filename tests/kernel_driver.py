@@ -1,5 +1,7 @@
-"""Drive every Cython kernel of boxtrees through edge cases; run under valgrind by
-test_boxtrees_memcheck.py, which fails on any invalid read or write in boxtrees code.
+"""Drive every Cython kernel of boxtrees, SIMD and portable, through edge cases.
+
+Run under valgrind by test_boxtrees_memcheck.py and on an AddressSanitizer build by
+test_boxtrees_asan.py; both fail on any invalid read or write in boxtrees code.
 
 Imports only NumPy and the extension modules (not scikit-learn), to stay fast under valgrind.
 """
@@ -41,9 +43,10 @@ def main():
     rng = np.random.default_rng(0)
     for case, (n, per_sample, n_types, n_bands, spread) in enumerate(
         # boxes hitting every sample (several times), ragged sets, no objects, objects outside
-        # the bounds, two samples
+        # the bounds, two samples, more objects of a type than a SIMD step takes (16) and
+        # segments long enough to be searched
         [(40, 6, 1, 1, 0.5), (60, -12, 3, 4, 1.0), (30, 0, 2, 3, 1.0), (50, -3, 4, 8, 5.0),
-         (2, 1, 1, 1, 1.0)]
+         (2, 1, 1, 1, 1.0), (40, -60, 2, 2, 1.0)]
     ):
         data, offsets, x, y, sample, segment_ptr, edges = training_arrays(
             rng, n, per_sample, n_types, n_bands, spread)
@@ -52,13 +55,14 @@ def main():
         for test_type in ("random", "fixed", "bounded", "classic"):
             for simd in (True, False):
                 _builder._set_simd(simd)
+                _predictor._set_simd(simd)
                 trees = [_tree.BoxTree(**_builder.build_tree(
                     x, y, sample, segment_ptr, edges, target, weight, bounds, False, False,
                     test_type, 0.7, 20, 2.0, -1, 2, seed)) for seed in range(3)]
-            forest = _tree.PackedForest(trees)
-            samples = _rows.group_by_type(data, offsets, n_types)
-            _predictor.predict_mean(forest, samples, 0, n, np.empty(n))
-            _predictor.apply_leaves(forest, samples, 0, n, np.empty((n, 3), dtype=np.intp))
+                forest = _tree.PackedForest(trees)
+                samples = _rows.group_by_type(data, offsets, n_types)
+                _predictor.predict_mean(forest, samples, 0, n, np.empty(n))
+                _predictor.apply_leaves(forest, samples, 0, n, np.empty((n, 3), dtype=np.intp))
             assert _rows.scan_rows(data, 3e38, 2**24)[0] == 0, case
     # one object per sample and type: the strip-sum scoring path
     n, n_features = 80, 3
