@@ -108,7 +108,7 @@ cdef extern from "_simd.h":
 
 cdef enum:
     SHORT_SEGMENT = 160  # segments up to this long are scanned whole instead of searched
-    SIMD_SLACK = 16  # spare slots the SIMD kernels may write past their count
+    SIMD_SLACK = 16  # spare slots the SIMD compactions may write past their count
 
 # the data-parallel kernels used by every tree (see _simd.h)
 cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)
@@ -182,9 +182,9 @@ cdef class _Splitter:
         self.ys = <coord_t*>self._own(np.array(y, dtype=np.float32))
         self.sid = <int32*>self._own(np.array(sample_of, dtype=np.int32))
         # scratch for one segment at a time: its right-going objects, or a strip's hits
-        self.tmp_x = <coord_t*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.float32))
-        self.tmp_y = <coord_t*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.float32))
-        self.tmp_sid = <int32*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.int32))
+        self.tmp_x = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
+        self.tmp_y = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
+        self.tmp_sid = <int32*>self._own(np.empty(max_segment, dtype=np.int32))
         self.strip = <int32*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.int32))
         self.order = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
         self.new_id = <int32*>self._own(np.empty(n_samples, dtype=np.int32))

@@ -10,8 +10,8 @@
  *
  * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
  * run time, so the default build stays portable) sixteen objects are handled per step. Both
- * versions write exactly the same results; the AVX-512 ones may write up to 16 slots past the
- * returned count of `out`, and of the partition's scratch arrays, so those need 16 spare slots.
+ * versions write exactly the same results; the AVX-512 compactions may write up to 16 slots
+ * past the returned count, so `out` needs 16 spare slots.
  */
 #ifndef BOXTREES_SIMD_H
 #define BOXTREES_SIMD_H
@@ -27,7 +27,6 @@ typedef int64_t (*boxtrees_compact_box_fn)(const float *xs, const float *ys, con
 typedef int64_t (*boxtrees_partition_fn)(float *xs, float *ys, int32_t *sid, int64_t n,
                                          const int32_t *new_id, int32_t mid, float *tmp_x,
                                          float *tmp_y, int32_t *tmp_sid);
-
 
 /* A node test as the traversal reads it (boxtrees._tree.NODE_DTYPE): child ids local to the
    tree, left = -1 at a leaf (TREE_LEAF). */
@@ -171,9 +170,9 @@ static int64_t boxtrees_compact_avx512(const float *ys, const int32_t *sid, int6
     return k + boxtrees_compact_portable(ys + j, sid + j, n - j, ymin, ymax, out + k);
 }
 
-/* Whole 16-lane stores into the run are safe: the left count never passes the objects
-   already loaded. The last partial block is left to the scalar loop, so nothing past the run
-   is written. */
+/* Whole 16-lane stores are safe: neither count passes the objects already loaded, so they
+   stay within the run and within a scratch as long as the run. The last partial block is left
+   to the scalar loop. */
 __attribute__((target("avx512f")))
 static int64_t boxtrees_partition_avx512(float *xs, float *ys, int32_t *sid, int64_t n,
                                          const int32_t *new_id, int32_t mid, float *tmp_x,
@@ -210,7 +209,7 @@ static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes, const float
     while (n->left != -1) {
         int64_t k = types[n->object_type], end = types[n->object_type + 1];
         int32_t count = 0;
-        do {    /* once for up to 16 objects, none included */
+        do {    /* one pass for up to 16 objects (and for none) */
             __mmask16 live = end - k >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << (end - k)) - 1u);
             __m512 xs = _mm512_maskz_loadu_ps(live, x + k), ys = _mm512_maskz_loadu_ps(live, y + k);
             __mmask16 in = live & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[0]), _CMP_GT_OQ)
