@@ -85,7 +85,7 @@ def _header(experiments, budget, seeds, elapsed, n_run):
         f"{timing} Finished runs are cached under `runs/{budget.name}/`; re-running the "
         f"command resumes.\n\n"
         f"Budget `{budget.name}`: {budget.seeds} run(s) per setting"
-        f"{'' if seeds is None else f' (seeds {list(seeds)})'}, {budget.iterations} "
+        f"{'' if seeds is None else f' (this invocation: seeds {list(seeds)})'}, {budget.iterations} "
         f"iterations x {budget.samples:,} samples (x2 for the sword game), greedy evaluation "
         f"over {budget.eval_steps:,} steps on the fixed reference worlds"
         f"{'' if budget.eval_steps == 20_000 else ' (fewer than the thesis: rewards rescaled)'}"
