@@ -1,9 +1,11 @@
 """`FQI`: fitted Q-iteration with one scikit-learn regressor per action."""
 import dataclasses
+import os
+import pickle
 import time
 import warnings
 from concurrent.futures import ThreadPoolExecutor
-from numbers import Integral, Real
+from numbers import Integral
 
 import joblib
 import numpy as np
@@ -14,6 +16,8 @@ from tqdm.auto import tqdm
 
 from envs import WorldRules
 
+from ._checks import (_check_bool, _check_int, _check_n_jobs, _check_real, _check_seed,
+                      _check_steps)
 from ._collect import _Collector, _Transitions
 from ._evaluate import evaluate
 from ._logger import CSVLogger
@@ -23,6 +27,8 @@ from ._worlds import _world_rules
 __all__ = ["FQI"]
 
 _SAVE_FORMAT = 1
+_SAVE_KEYS = frozenset({"format", "params", "rules", "q_functions_", "history",
+                        "num_timesteps", "iteration", "rngs"})
 
 
 class FQI:
@@ -52,11 +58,14 @@ class FQI:
     Parameters
     ----------
     regressor : scikit-learn regressor
-        Template of the per-action Q-functions; must have ``fit`` and ``predict`` and be
-        clonable. A ``random_state`` parameter (also nested, ``step__random_state``) is
-        set from `seed` on each clone. For `boxtrees.BoxExtraTreesRegressor`, set
-        ``n_jobs=-1`` to use every core and ``view_bounds=env view`` to draw tests in the
-        view square (`fqi.make_box_forest` does both).
+        Template of the per-action Q-functions; must have ``fit`` and ``predict``, be
+        clonable and take object sets (else a TypeError or ValueError at its first fit),
+        and predict one finite value per observation (else a ValueError naming the action
+        and the iteration). A ``random_state`` parameter (also nested,
+        ``step__random_state``) is set from `seed` on each clone. For
+        `boxtrees.BoxExtraTreesRegressor`, set ``n_jobs=-1`` to use every core and
+        ``view_bounds=env view`` to draw tests in the view square (`fqi.make_box_forest`
+        does both).
     env : str, gymnasium.Env, envs.BatchedObjectWorld or envs.WorldRules
         The ObjectWorld variant: an id such as ``"ObjectWorld-v0"`` or an env instance
         (wrappers allowed) whose rules (``env.unwrapped.rules``) build the batched rollout
@@ -86,12 +95,13 @@ class FQI:
         Threads predicting the per-action Q-functions concurrently (at most one per
         action; -1: one per core). The box forests release the GIL while predicting.
     log_path : str or path-like, default=None
-        CSV file receiving one row per iteration (see `history` for the columns).
+        CSV file receiving one row per iteration (see `history` for the columns); its
+        directory must exist and be writable (checked here, see `CSVLogger`).
     seed : int or None, default=None
         Drives the training worlds, the exploration and the regressors' random states: the
         same seed gives the same reward curve.
-    verbose : int, default=0
-        1 prints one line per iteration.
+    verbose : int or bool, default=0
+        1 (or True) prints one line per iteration.
 
     Attributes
     ----------
@@ -136,25 +146,21 @@ class FQI:
         self.samples_per_iteration = _check_int("samples_per_iteration", samples_per_iteration, 1)
         self.resample_every = (None if resample_every is None
                                else _check_int("resample_every", resample_every, 1))
-        if not isinstance(keep_data, (bool, np.bool_)):
-            raise TypeError(f"keep_data must be a bool, got {keep_data!r}")
-        self.keep_data = bool(keep_data)
+        self.keep_data = _check_bool("keep_data", keep_data)
         self.max_samples = _check_int("max_samples", max_samples, 1)
         if self.keep_data and self.max_samples < self.samples_per_iteration:
             raise ValueError(f"max_samples ({self.max_samples}) must be at least "
                              f"samples_per_iteration ({self.samples_per_iteration})")
         self.n_worlds = _check_int("n_worlds", n_worlds, 1)
-        self.eval_steps = _check_int("eval_steps", eval_steps, 0)
-        if self.eval_steps % self.rules.max_steps:
-            raise ValueError(f"eval_steps must be a multiple of the episode length "
-                             f"{self.rules.max_steps}; got {self.eval_steps}")
-        if not isinstance(n_jobs, Integral) or isinstance(n_jobs, bool) or n_jobs == 0:
-            raise ValueError(f"n_jobs must be a non-zero int, got {n_jobs!r}")
-        self.n_jobs = int(n_jobs)
-        if seed is not None:
-            _check_int("seed", seed, 0)
-        self.seed = seed
-        self.verbose = verbose
+        self.eval_steps = _check_steps("eval_steps", eval_steps, self.rules.max_steps,
+                                       allow_zero=True)
+        self.n_jobs = _check_n_jobs(n_jobs)
+        self.seed = _check_seed("seed", seed)
+        if not isinstance(verbose, (Integral, np.bool_)):
+            raise TypeError(f"verbose must be an int or a bool, got {verbose!r}")
+        if verbose < 0:
+            raise ValueError(f"verbose must be >= 0, got {verbose}")
+        self.verbose = int(verbose)
         self.log_path = log_path
         self.logger = None if log_path is None else CSVLogger(log_path)
         world_seq, action_seq, fit_seq = np.random.SeedSequence(seed).spawn(3)
@@ -165,6 +171,7 @@ class FQI:
         self._pool = None
         self._data = None
         self.q_functions_ = None
+        self._q_iteration = None  # the iteration that fitted q_functions_
         self.history = []
         self.num_timesteps = 0
         self.iteration = 0
@@ -191,6 +198,7 @@ class FQI:
         """
         n_iterations = _check_int("n_iterations", n_iterations, 1)
         notify = _callback_function(callback)
+        progress_bar = _check_bool("progress_bar", progress_bar)
         if self._collector is None:
             self._collector = _Collector(self.rules, self.n_worlds, self._world_rng)
         with tqdm(total=n_iterations, desc="FQI", disable=not progress_bar) as bar:
@@ -230,6 +238,7 @@ class FQI:
         targeted = time.perf_counter()
 
         self.q_functions_ = [self._fit_action(a, data, targets) for a in range(self.n_actions)]
+        self._q_iteration = self.iteration
         fitted = time.perf_counter()
 
         reward = evaluate(self, self.rules, self.eval_steps) if self.eval_steps else np.nan
@@ -268,7 +277,12 @@ class FQI:
                         q.argmax(axis=1))
 
     def _fit_action(self, action, data, targets):
-        """A clone of the regressor fitted on the transitions with `action`."""
+        """A clone of the regressor fitted on the transitions with `action`.
+
+        A TypeError or ValueError of the agent's first fit is re-raised saying what the
+        regressor was given (object sets) and how to wrap a feature-vector regressor. Only
+        fitting tells whether a regressor takes object sets, so the constructor cannot.
+        """
         mask = data.actions == action
         if not mask.any():
             if self.q_functions_ is None:
@@ -282,7 +296,20 @@ class FQI:
         params = model.get_params()
         model.set_params(**{k: seed for k in params
                             if k == "random_state" or k.endswith("__random_state")})
-        return model.fit(data.states[mask], targets[mask])
+        try:
+            return model.fit(data.states[mask], targets[mask])
+        except (TypeError, ValueError) as exc:
+            if self.q_functions_ is not None or action > 0:
+                raise  # the regressor has taken object sets before
+            error = ValueError if isinstance(exc, ValueError) else TypeError
+            raise error(
+                f"{self.regressor!r} failed on its first fit, given object sets as a "
+                f"boxtrees.ObjectSets ({type(exc).__name__}: {exc}). FQI gives every "
+                f"regressor its observations as object sets (variable-size sets of "
+                f"[dx, dy, type] rows), not as a feature matrix: use a regressor that takes "
+                f"object sets, such as boxtrees.BoxExtraTreesRegressor (fqi.make_box_forest), "
+                f"or wrap a feature-vector regressor in a pipeline starting with "
+                f"boxtrees.GridCounts (fqi.make_grid_ridge)") from exc
 
     # ------------------------------------------------------------------ acting
     def q_values(self, observation):
@@ -307,7 +334,26 @@ class FQI:
         if self._pool is None:
             self._pool = ThreadPoolExecutor(min(effective_n_jobs(self.n_jobs), self.n_actions))
         predictions = self._pool.map(lambda model: model.predict(sets), self.q_functions_)
-        return np.column_stack([np.asarray(p, dtype=np.float64) for p in predictions])
+        q = np.empty((len(sets), self.n_actions))
+        for action, prediction in enumerate(predictions):
+            q[:, action] = self._checked_prediction(action, prediction, len(sets))
+        return q
+
+    def _checked_prediction(self, action, prediction, n):
+        """`prediction` of the Q-function of `action` for `n` observations, as floats of
+        shape ``(n,)``, after checking there are `n` of them and all are finite."""
+        prediction = np.asarray(prediction, dtype=np.float64)
+        bad = ~np.isfinite(prediction)
+        if prediction.size == n and not bad.any():
+            return prediction.reshape(n)
+        model = (f"iteration {self._q_iteration}'s Q-function of action {action} "
+                 f"({self.q_functions_[action]!r})")
+        if prediction.size != n:
+            raise ValueError(f"{model} predicted an array of size {prediction.size} for "
+                             f"{n} observations; a regressor must predict one value per "
+                             f"observation")
+        raise ValueError(f"{model} predicted non-finite Q-values (NaN or inf) for {bad.sum()} "
+                         f"of {n} observations; a regressor must predict finite values")
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         """Actions for one observation or a batch (the stable-baselines3 signature).
@@ -358,9 +404,14 @@ class FQI:
     def load(cls, path, env=None, log_path=None):
         """Load an agent saved by `save`.
 
+        Loading unpickles the file, which can run arbitrary code: load only trusted files.
+
         Parameters
         ----------
         path : str or path-like
+            A file written by `save`; ValueError for any other file (empty, truncated,
+            damaged, not an FQI save, or a save of another format version), and
+            FileNotFoundError for a missing one.
         env : str, gymnasium.Env or envs.WorldRules, default=None
             Play and train on this env instead of the saved rules (same number of actions).
         log_path : str or path-like, default=None
@@ -371,9 +422,7 @@ class FQI:
         agent : FQI
             Further `learn` calls continue the iteration count with freshly collected data.
         """
-        state = joblib.load(path)
-        if not isinstance(state, dict) or state.get("format") != _SAVE_FORMAT:
-            raise ValueError(f"{path} is not an FQI agent saved by FQI.save")
+        state = _read_save(path)
         rules = WorldRules(**state["rules"])
         agent = cls(env=rules if env is None else env, log_path=log_path, **state["params"])
         if agent.n_actions != rules.n_actions:
@@ -383,6 +432,7 @@ class FQI:
         agent.history = state["history"]
         agent.num_timesteps = state["num_timesteps"]
         agent.iteration = state["iteration"]
+        agent._q_iteration = agent.iteration - 1
         agent._world_rng, agent._action_rng, agent._fit_rng = state["rngs"]
         return agent
 
@@ -396,6 +446,34 @@ class FQI:
                 f"epsilon={self.epsilon}, samples_per_iteration={self.samples_per_iteration}, "
                 f"resample_every={self.resample_every}, keep_data={self.keep_data}, "
                 f"iteration={self.iteration})")
+
+
+def _read_save(path):
+    """The state that `FQI.save` wrote to `path`, or a ValueError saying why the file is
+    not one (FileNotFoundError when it does not exist)."""
+    path = os.fspath(path)
+    with open(path, "rb") as f:
+        head = f.read(1)
+    if not head:
+        raise ValueError(f"{path} is empty, not an agent saved by FQI.save")
+    if head != pickle.PROTO:  # FQI.save writes an uncompressed joblib pickle
+        raise ValueError(f"{path} is not an agent saved by FQI.save (not a joblib pickle)")
+    try:
+        state = joblib.load(path)
+    except Exception as exc:  # unpickling damaged data can raise almost anything
+        raise ValueError(f"{path} could not be read as an agent saved by FQI.save: it is "
+                         f"truncated or damaged ({type(exc).__name__}: {exc})") from exc
+    if not isinstance(state, dict) or "format" not in state:
+        raise ValueError(f"{path} is a joblib pickle of a {type(state).__name__}, not an "
+                         f"agent saved by FQI.save")
+    if state["format"] != _SAVE_FORMAT:
+        raise ValueError(f"{path} is an FQI save of format version {state['format']!r}; "
+                         f"this version of fqi reads version {_SAVE_FORMAT}")
+    missing = sorted(_SAVE_KEYS - state.keys())
+    if missing:
+        raise ValueError(f"{path} is not an agent saved by FQI.save: it lacks "
+                         f"{', '.join(missing)}")
+    return state
 
 
 def _callback_function(callback):
@@ -419,21 +497,3 @@ def _nodes_per_tree(models):
         for tree in getattr(forest, "estimators_", []):
             counts.append(getattr(tree, "tree_", tree).node_count)
     return float(np.mean(counts)) if counts else np.nan
-
-
-# Not sklearn.utils.check_scalar: it accepts NaN for a bounded float and True for an int.
-def _check_int(name, value, low):
-    if not isinstance(value, Integral) or isinstance(value, bool):
-        raise TypeError(f"{name} must be an int, got {value!r}")
-    if value < low:
-        raise ValueError(f"{name} must be >= {low}, got {value}")
-    return int(value)
-
-
-def _check_real(name, value, low, high, high_inclusive=True):
-    if not isinstance(value, Real) or isinstance(value, bool):
-        raise TypeError(f"{name} must be a number, got {value!r}")
-    if not (low <= value <= high) or (value == high and not high_inclusive):
-        bracket = "]" if high_inclusive else ")"
-        raise ValueError(f"{name} must lie in [{low}, {high}{bracket}, got {value}")
-    return float(value)

@@ -10,6 +10,8 @@ from sklearn.pipeline import make_pipeline
 
 from boxtrees import BoxExtraTreesRegressor, GridCounts
 
+from ._checks import (_check_bool, _check_int, _check_n_jobs, _check_real, _check_seed,
+                      _check_steps)
 from ._evaluate import evaluate
 from ._observations import _observation_batch
 from ._worlds import _world_rules
@@ -41,17 +43,25 @@ def make_box_forest(env="ObjectWorld-v0", *, test_type="fixed", test_width=1.0,
     ----------
     env : str, gymnasium.Env or envs.WorldRules, default="ObjectWorld-v0"
     test_type, test_width, n_estimators, n_tests, min_samples_split, n_jobs, random_state
-        As in `boxtrees.BoxExtraTreesRegressor` (``n_jobs=-1``: every core).
+        As in `boxtrees.BoxExtraTreesRegressor` (``n_jobs=-1``: every core), and checked
+        here against its parameter constraints rather than at the first fit.
 
     Returns
     -------
     regressor : boxtrees.BoxExtraTreesRegressor
     """
     view = _world_rules(env).obs_bound
-    return BoxExtraTreesRegressor(
+    # what the forest's constraints let through: True for an int, n_jobs=0 (joblib's error)
+    n_estimators = _check_int("n_estimators", n_estimators, 1)
+    n_tests = _check_int("n_tests", n_tests, 1)
+    if n_jobs is not None:
+        n_jobs = _check_n_jobs(n_jobs)
+    forest = BoxExtraTreesRegressor(
         n_estimators, n_tests=n_tests, min_samples_split=min_samples_split,
         test_type=test_type, test_width=test_width, view_bounds=(-view, view, -view, view),
         n_jobs=n_jobs, random_state=random_state)
+    forest._validate_params()  # the rest, now rather than at the first fit
+    return forest
 
 
 def make_grid_ridge(env="ObjectWorld-v0", *, n_bins=10, alpha=1.0):
@@ -62,8 +72,9 @@ def make_grid_ridge(env="ObjectWorld-v0", *, n_bins=10, alpha=1.0):
     env : str, gymnasium.Env or envs.WorldRules, default="ObjectWorld-v0"
         Fixes the grid extent (the view square) and the number of types.
     n_bins : int, default=10
+        Cells along each axis, at least 1.
     alpha : float, default=1.0
-        Ridge penalty.
+        Ridge penalty, at least 0.
 
     Returns
     -------
@@ -71,8 +82,10 @@ def make_grid_ridge(env="ObjectWorld-v0", *, n_bins=10, alpha=1.0):
     """
     rules = _world_rules(env)
     view = rules.obs_bound
-    return make_pipeline(GridCounts(n_bins, view_bounds=(-view, view, -view, view),
-                                    n_types=rules.n_types), Ridge(alpha=alpha))
+    return make_pipeline(
+        GridCounts(_check_int("n_bins", n_bins, 1), view_bounds=(-view, view, -view, view),
+                   n_types=rules.n_types),
+        Ridge(alpha=_check_real("alpha", alpha, 0.0, np.inf, high_inclusive=False)))
 
 
 class _GridModelPolicy:
@@ -127,10 +140,11 @@ def train_dqn(env="ObjectWorld-v0", total_timesteps=400_000, *, n_bins=10, gamma
     n_bins : int, default=10
         Grid cells per axis of the observation.
     gamma : float, default=0.5
-        Discount factor (the FQI default, for a like-for-like comparison).
+        Discount factor in ``[0, 1]`` (the FQI default, for a like-for-like comparison).
     eval_steps : int, default=20_000
-        Steps of the evaluation on the reference worlds; 0 skips it.
-    seed : int or None, default=None
+        Steps of the evaluation on the reference worlds, a multiple of the episode length
+        (50); 0 skips it.
+    seed : int >= 0 or None, default=None
         Seeds DQN (and through it the training worlds, below ``2**40``).
     torch_threads : int, default=1
         Torch threads while training (restored afterwards). On 2 shared cores the
@@ -138,6 +152,8 @@ def train_dqn(env="ObjectWorld-v0", total_timesteps=400_000, *, n_bins=10, gamma
     progress_bar : bool, default=False
     **dqn_kwargs
         Override the DQN settings (see ``_DQN_DEFAULTS`` in this module).
+
+    Every argument is checked before training starts.
 
     Returns
     -------
@@ -149,6 +165,13 @@ def train_dqn(env="ObjectWorld-v0", total_timesteps=400_000, *, n_bins=10, gamma
 
     if not isinstance(env, str):
         raise TypeError(f"env must be a registered env id, got {type(env).__name__}")
+    rules = _world_rules(env)
+    total_timesteps = _check_int("total_timesteps", total_timesteps, 1)
+    gamma = _check_real("gamma", gamma, 0.0, 1.0)
+    eval_steps = _check_steps("eval_steps", eval_steps, rules.max_steps, allow_zero=True)
+    seed = _check_seed("seed", seed)
+    torch_threads = _check_int("torch_threads", torch_threads, 1)
+    progress_bar = _check_bool("progress_bar", progress_bar)
     train_env = GridObservation(gym.make(env), n_bins=n_bins)
     model = DQN("MlpPolicy", train_env, gamma=gamma, seed=seed, device="cpu",
                 **{**_DQN_DEFAULTS, **dqn_kwargs})

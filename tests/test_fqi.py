@@ -1,12 +1,15 @@
 """The FQI agent: SB3-style API, data regimes, determinism, persistence, learning, bad input."""
 import csv
+import os
 import tempfile
 
 import gymnasium as gym
+import joblib
 import numpy as np
 import pytest
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.exceptions import NotFittedError
+from sklearn.linear_model import Ridge
 
 import envs
 from boxtrees import BoxExtraTreesRegressor, ObjectSets
@@ -300,6 +303,9 @@ def test_env_needs_discrete_actions_and_object_world():
     ({"eval_steps": 120}, ValueError, "multiple of the episode length"),
     ({"n_worlds": 0}, ValueError, "n_worlds"),
     ({"n_jobs": 0}, ValueError, "n_jobs"),
+    ({"n_jobs": 1.5}, TypeError, "n_jobs must be an int"),
+    ({"verbose": "yes"}, TypeError, "verbose must be an int or a bool"),
+    ({"verbose": -1}, ValueError, "verbose must be >= 0"),
 ])
 def test_bad_parameters(params, error, match):
     with pytest.raises(error, match=match):
@@ -328,11 +334,156 @@ def test_predict_before_learn_and_bad_learn_arguments(tmp_path):
         agent.learn(0)
     with pytest.raises(TypeError, match="callback"):
         agent.learn(1, callback=3)
-    path = tmp_path / "other.joblib"
-    import joblib
-    joblib.dump({"something": 1}, path)
-    with pytest.raises(ValueError, match="not an FQI agent"):
+    with pytest.raises(TypeError, match="progress_bar must be a bool"):
+        agent.learn(1, progress_bar="yes")
+
+
+def test_log_path_is_checked_at_construction(tmp_path, monkeypatch):
+    with pytest.raises(FileNotFoundError, match="directory .*missing.* does not exist"):
+        small_agent(log_path=tmp_path / "missing" / "log.csv")
+    with pytest.raises(IsADirectoryError, match="is a directory"):
+        small_agent(log_path=tmp_path)
+    with pytest.raises(TypeError, match="log path must be a str or path-like"):
+        small_agent(log_path=3)
+    monkeypatch.setattr(os, "access", lambda path, mode: False)  # tests may run as root
+    with pytest.raises(PermissionError, match="not writable"):
+        small_agent(log_path=tmp_path / "log.csv")
+
+
+def _truncated_save(agent, path):
+    agent.save(path)
+    saved = path.read_bytes()
+    path.write_bytes(saved[:len(saved) // 2])
+
+
+@pytest.mark.parametrize("write, match", [
+    (lambda agent, path: path.write_bytes(b""), "is empty"),
+    (lambda agent, path: path.write_bytes(np.random.default_rng(0).bytes(300)),
+     r"not an agent saved by FQI.save \(not a joblib pickle\)"),
+    (lambda agent, path: path.write_text("iteration,reward\n0,1.0\n"), "not a joblib pickle"),
+    (_truncated_save, "truncated or damaged"),
+    (lambda agent, path: joblib.dump([1, 2], path), "pickle of a list, not an agent"),
+    (lambda agent, path: joblib.dump({"rules": {}}, path), "pickle of a dict, not an agent"),
+    (lambda agent, path: joblib.dump({"format": 2}, path),
+     "FQI save of format version 2; this version of fqi reads version 1"),
+    (lambda agent, path: joblib.dump({"format": 1, "params": {}}, path),
+     "not an agent saved by FQI.save: it lacks history, iteration"),
+])
+def test_load_names_the_file_and_what_is_wrong(trained, tmp_path, write, match):
+    path = tmp_path / "agent.joblib"
+    write(trained, path)
+    with pytest.raises(ValueError, match=match) as excinfo:
         FQI.load(path)
+    assert str(path) in str(excinfo.value)
+
+
+def test_load_of_a_missing_file_is_file_not_found(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        FQI.load(tmp_path / "missing.joblib")
+
+
+class ConstantQ(RegressorMixin, BaseEstimator):
+    """Q(s) = value everywhere, predicted `n_values` times per batch (default: one per set)."""
+
+    def __init__(self, value=0.0, n_values=None):
+        self.value = value
+        self.n_values = n_values
+
+    def fit(self, X, y):
+        return self
+
+    def predict(self, X):
+        return np.full(len(X) if self.n_values is None else self.n_values, self.value)
+
+
+@pytest.mark.parametrize("regressor, match", [
+    (ConstantQ(np.nan), r"predicted non-finite Q-values \(NaN or inf\) for 10 of 10"),
+    (ConstantQ(np.inf), "non-finite"),
+    (ConstantQ(n_values=1), "predicted an array of size 1 for 10 observations"),
+])
+def test_bad_predictions_stop_training_at_their_iteration(regressor, match):
+    agent = small_agent(regressor, eval_steps=500)  # evaluates 10 worlds at iteration 0
+    with pytest.raises(ValueError, match=match) as excinfo:
+        agent.learn(3)
+    assert str(excinfo.value).startswith("iteration 0's Q-function of action 0 (ConstantQ(")
+    assert agent.history == []
+    agent = small_agent(regressor, eval_steps=0)  # first predicts while collecting, iteration 1
+    with pytest.raises(ValueError, match="iteration 0's Q-function of action 0"):
+        agent.learn(3)
+    assert len(agent.history) == 1
+
+
+def test_regressor_without_object_sets_is_told_to_wrap_them():
+    agent = small_agent(Ridge())
+    with pytest.raises(ValueError, match=r"Ridge\(\) failed on its first fit, given "
+                       r"object sets as a boxtrees.ObjectSets") as excinfo:
+        agent.learn(1)
+    message = str(excinfo.value)
+    assert "a pipeline starting with boxtrees.GridCounts" in message
+    assert isinstance(excinfo.value.__cause__, ValueError) and agent.history == []
+
+
+@pytest.mark.parametrize("kwargs, error, match", [
+    ({"eval_steps": 70}, ValueError, "eval_steps must be 0 or a positive multiple of the "
+                                     "episode length 50; got 70"),
+    ({"total_timesteps": 0}, ValueError, "total_timesteps must be >= 1"),
+    ({"gamma": float("nan")}, ValueError, r"gamma must lie in \[0.0, 1.0\]"),
+    ({"seed": -1}, ValueError, "seed must be >= 0"),
+    ({"torch_threads": 0}, ValueError, "torch_threads must be >= 1"),
+    ({"progress_bar": 1}, TypeError, "progress_bar must be a bool"),
+])
+def test_train_dqn_checks_every_argument_before_training(monkeypatch, kwargs, error, match):
+    from stable_baselines3 import DQN
+
+    def no_training(*args, **kwargs):
+        raise AssertionError("training started")
+
+    monkeypatch.setattr(DQN, "learn", no_training)
+    with pytest.raises(error, match=match):
+        train_dqn(ENV, **kwargs)
+
+
+@pytest.mark.parametrize("make, error, match", [
+    (lambda: make_box_forest(n_estimators=0), ValueError, "n_estimators must be >= 1"),
+    (lambda: make_box_forest(n_tests=True), TypeError, "n_tests must be an int"),
+    (lambda: make_box_forest(n_jobs=0), ValueError, "n_jobs must be a non-zero int"),
+    (lambda: make_box_forest(test_type="square"), ValueError, "'test_type' parameter"),
+    (lambda: make_box_forest(test_width=float("nan")), ValueError, "'test_width' parameter"),
+    (lambda: make_box_forest(random_state=-1), ValueError, "'random_state' parameter"),
+    (lambda: make_grid_ridge(n_bins=0), ValueError, "n_bins must be >= 1"),
+    (lambda: make_grid_ridge(alpha=-1.0), ValueError, r"alpha must lie in \[0.0, inf\)"),
+    (lambda: make_grid_ridge(alpha=float("nan")), ValueError, "alpha"),
+    (lambda: RandomPolicy(ENV, seed=-1), ValueError, "seed must be >= 0"),
+    (lambda: RandomPolicy(ENV, seed=True), TypeError, "seed must be an int"),
+])
+def test_baselines_check_their_parameters(make, error, match):
+    with pytest.raises(error, match=match):
+        make()
+
+
+class ScriptedPolicy:
+    """``predict`` returns ``answer(n)`` for a batch of n observations."""
+
+    def __init__(self, answer):
+        self.answer = answer
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        return self.answer(len(observation))
+
+
+@pytest.mark.parametrize("policy, error, match", [
+    (object(), TypeError, "policy must have a method predict.*object has no predict"),
+    (ScriptedPolicy(lambda n: (np.zeros(3, int), None)), ValueError,
+     r"returned 3 actions \(shape \(3,\)\) for a batch of 10 observations; expected 10"),
+    (ScriptedPolicy(lambda n: (np.full(n, 7), None)), ValueError,
+     r"returned action 7; the action space is Discrete\(4\)"),
+    (ScriptedPolicy(lambda n: (np.full(n, -1), None)), ValueError, "returned action -1"),
+    (ScriptedPolicy(lambda n: (np.zeros(n), None)), ValueError, "int actions.*float64"),
+    (ScriptedPolicy(lambda n: np.zeros(n, int)), TypeError, r"pair \(actions, state\)"),
+])
+def test_evaluate_checks_the_policy_and_its_actions(policy, error, match):
+    with pytest.raises(error, match=match):
+        evaluate(policy, ENV, 500)
 
 
 def test_evaluate_rejects_bad_step_counts():
@@ -340,6 +491,8 @@ def test_evaluate_rejects_bad_step_counts():
         evaluate(RandomPolicy(ENV), ENV, 1234)
     with pytest.raises(ValueError, match="positive multiple"):
         evaluate(RandomPolicy(ENV), ENV, 0)
+    with pytest.raises(TypeError, match="n_steps must be an int"):
+        evaluate(RandomPolicy(ENV), ENV, 500.0)
 
 
 def test_transitions_concatenate_drops_unknown_next_values():
