@@ -20,8 +20,10 @@ cimport cython
 cimport numpy as cnp
 
 from libc.math cimport INFINITY
-from libc.limits cimport INT_MAX
+from libc.limits cimport INT_MAX, UINT_MAX
 from libcpp.vector cimport vector
+
+from ._rows import scan_offsets
 
 from ._utils cimport (
     BOUNDED, CLASSIC, FIXED, RANDOM, TREE_LEAF, TREE_UNDEFINED,
@@ -33,6 +35,9 @@ TEST_KINDS = {"random": RANDOM, "fixed": FIXED, "bounded": BOUNDED, "classic": C
 
 
 cdef double TIE_TOLERANCE = 1e-11
+# a feature-matrix column whose range in a node is at most this is constant there (as in
+# scikit-learn's trees): tests are not drawn on it
+cdef double FEATURE_THRESHOLD = 1e-7
 
 
 cdef struct BoxTest:
@@ -153,6 +158,8 @@ cdef class _Splitter:
     cdef float64_t* weighted_target  # weight * target
     cdef double* region              # per type of the current node: x0, x1, y0, y1 of its tests
     cdef intp_t* type_size           # per type: the current node's number of objects
+    cdef intp_t* live                # the types tests are drawn on in the current node
+    cdef intp_t n_live
     cdef const float64_t* edges      # band edges, n_bands + 1, from -inf to +inf
     cdef const coord_t[:, ::1] bounds
     cdef intp_t n_samples
@@ -180,7 +187,10 @@ cdef class _Splitter:
         self._keep_alive = []
         self.xs = <coord_t*>self._own(np.array(x, dtype=np.float32))
         self.ys = <coord_t*>self._own(np.array(y, dtype=np.float32))
-        self.sid = <int32*>self._own(np.array(sample_of, dtype=np.int32))
+        sid = np.array(sample_of, dtype=np.int32)   # checked here, on the copy the tree uses
+        if sid.size and (sid.min() < 0 or sid.max() >= n_samples):
+            raise ValueError(f"sample_of must hold sample ids in [0, {n_samples})")
+        self.sid = <int32*>self._own(sid)
         # scratch for one segment at a time: its right-going objects, or a strip's hits
         self.tmp_x = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
         self.tmp_y = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
@@ -201,9 +211,11 @@ cdef class _Splitter:
         self.target = <float64_t*>self._own(target)
         self.weight = <float64_t*>self._own(weight)
         self.weighted_target = <float64_t*>self._own(weight * target)
-        self.edges = <const float64_t*>self._own(np.ascontiguousarray(band_edges, dtype=np.float64))
+        self.edges = <const float64_t*>self._own(np.array(band_edges, dtype=np.float64))
         self.region = <double*>self._own(np.empty(4 * bounds.shape[0], dtype=np.float64))
         self.type_size = <intp_t*>self._own(np.empty(bounds.shape[0], dtype=np.intp))
+        self.live = <intp_t*>self._own(np.arange(bounds.shape[0], dtype=np.intp))
+        self.n_live = bounds.shape[0]
         self.bounds = bounds
         self.n_samples = n_samples
         self.n_types = bounds.shape[0]
@@ -218,7 +230,11 @@ cdef class _Splitter:
 
     cdef void start_node(self, intp_t start, intp_t end, double w_sum, double wy_sum,
                          double wy2_sum) noexcept nogil:
-        """Make samples ``start:end`` (and the segment ranges ``lo:hi``) the node to split."""
+        """Make samples ``start:end`` (and the segment ranges ``lo:hi``) the node to split.
+
+        Tests are drawn on every type of the training set, or with node-local ranges (feature
+        matrices) on the columns that are not constant in the node.
+        """
         cdef intp_t ty, g
         cdef double* r
         self.start = start
@@ -243,6 +259,13 @@ cdef class _Splitter:
                 if self.local_x and self.hi[g] > self.lo[g]:
                     r[0] = min(r[0], self.xs[self.lo[g]])
                     r[1] = max(r[1], self.xs[self.hi[g] - 1])
+        if self.local_x:
+            self.n_live = 0
+            for ty in range(self.n_types):
+                r = self.region + 4 * ty
+                if r[1] - r[0] > FEATURE_THRESHOLD:
+                    self.live[self.n_live] = ty
+                    self.n_live += 1
 
     cdef void* _own(self, cnp.ndarray array):
         """Keep ``array`` alive as long as the splitter and return its data pointer."""
@@ -251,7 +274,7 @@ cdef class _Splitter:
 
     cdef bint sample_test(self, BoxTest* t) noexcept nogil:
         """Draw a test; False when its type has no object in the node (it cannot split)."""
-        cdef intp_t ty = rand_int(&self.rng, self.n_types)
+        cdef intp_t ty = self.live[rand_int(&self.rng, self.n_live)]
         cdef const double* r = self.region + 4 * ty
         cdef double x0 = r[0], x1 = r[1], y0 = r[2], y1 = r[3]
         cdef bint one_dim = y0 == -INFINITY     # feature-matrix columns: the y extent is unbounded
@@ -410,6 +433,8 @@ cdef class _Splitter:
         cdef intp_t r, k
         cdef bint found = False
         best.proxy = -INFINITY
+        if self.n_live == 0:
+            return False
         for r in range(self.max_retries + 1):
             for k in range(self.n_tests):
                 if not self.sample_test(&t):
@@ -475,7 +500,7 @@ cdef class _Splitter:
 
 
 cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segment_ptr,
-                double min_samples_split, intp_t max_depth) noexcept nogil:
+                intp_t min_samples_split, intp_t max_depth) noexcept nogil:
     """Grow the tree depth first; ``nodes`` receives the flat node list."""
     cdef intp_t n_segments = segment_ptr.shape[0] - 1
     cdef vector[StackRecord] stack
@@ -526,7 +551,7 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segme
             else:
                 nodes[0][rec.parent].right = node_id
 
-        if (rec.end - rec.start < 2 or w < min_samples_split or ymin == ymax
+        if (rec.end - rec.start < max(min_samples_split, 2) or ymin == ymax
                 or (max_depth >= 0 and rec.depth >= max_depth)):
             continue
         splitter.start_node(rec.start, rec.end, w, wy, wy2)
@@ -550,10 +575,10 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segme
             ranges.push_back(right_lo[g])
 
 
-def build_tree(x, y, sample_of, const intp_t[::1] segment_ptr, band_edges, target, weight,
+def build_tree(x, y, sample_of, segment_ptr, band_edges, target, weight,
                const coord_t[:, ::1] bounds, bint local_x, bint one_per_sample, str test_type,
                double test_width,
-               intp_t n_tests, double min_samples_split, intp_t max_depth, intp_t max_retries,
+               intp_t n_tests, intp_t min_samples_split, intp_t max_depth, intp_t max_retries,
                uint64 seed):
     """Grow one tree and return its node arrays as a dict.
 
@@ -568,7 +593,7 @@ def build_tree(x, y, sample_of, const intp_t[::1] segment_ptr, band_edges, targe
         Band ``b`` holds the objects with ``band_edges[b] <= y < band_edges[b + 1]``; the
         first edge is -inf and the last +inf.
     target, weight : arrays of shape (n_samples,)
-        Regression targets and (strictly positive) sample weights.
+        Regression targets and (strictly positive) sample weights; ``n_samples < 2**31``.
     bounds : array of shape (n_types, 4)
         Region ``(xmin, xmax, ymin, ymax)`` in which tests of each type are drawn; ``ymin =
         -inf`` marks one-dimensional objects (feature-matrix columns).
@@ -578,17 +603,39 @@ def build_tree(x, y, sample_of, const intp_t[::1] segment_ptr, band_edges, targe
         Every sample has exactly one object of each type (a feature matrix): enables a faster,
         equivalent scoring of tests.
     test_type, test_width, n_tests, min_samples_split, max_depth, max_retries
-        As in ``BoxExtraTreesRegressor``; ``max_depth < 0`` means unlimited.
+        As in ``BoxExtraTreesRegressor``; ``min_samples_split`` is a number of samples and
+        ``max_depth < 0`` means unlimited.
     seed : int
         Seed of the tree's random generator.
+
+    Raises
+    ------
+    ValueError
+        When the arrays do not fit together (the tree reads them by index, so they are
+        checked, on the copies it uses, before it grows).
     """
+    segment_ptr = np.array(segment_ptr, dtype=np.intp)
+    n_objects, n_samples = len(x), len(target)
+    n_bands = len(band_edges) - 1
+    if len(y) != n_objects or len(sample_of) != n_objects:
+        raise ValueError("x, y and sample_of must have one entry per object")
+    if len(weight) != n_samples or not 0 < n_samples < INT_MAX:
+        raise ValueError(f"target and weight must have the same length, from 1 to {INT_MAX - 1}")
+    if bounds.shape[1] != 4 or n_bands < 1 or segment_ptr.shape != (bounds.shape[0] * n_bands + 1,):
+        raise ValueError("bounds must be (n_types, 4) and segment_ptr must have "
+                         "n_types * n_bands + 1 entries")
+    if scan_offsets(segment_ptr, n_objects) != -1:
+        raise ValueError(f"segment_ptr must rise from 0 to the number of objects, {n_objects}")
+    if not 0 < n_tests <= UINT_MAX or max_retries < 0:
+        raise ValueError(f"n_tests must be in [1, {UINT_MAX}] and max_retries >= 0")
     cdef intp_t max_segment = max(np.diff(segment_ptr).max(initial=0), 1)
     cdef _Splitter splitter = _Splitter(
         x, y, sample_of, max_segment, target, weight, band_edges, bounds, local_x,
         one_per_sample, TEST_KINDS[test_type], test_width, n_tests, max_retries, seed)
     cdef vector[Node] nodes
+    cdef const intp_t[::1] segments = segment_ptr
     with nogil:
-        _grow(splitter, &nodes, segment_ptr, min_samples_split, max_depth)
+        _grow(splitter, &nodes, segments, min_samples_split, max_depth)
     return _to_arrays(nodes)
 
 

@@ -1,29 +1,19 @@
 """``BoxExtraTreesRegressor``: an Extra-Trees forest whose node tests count objects in boxes."""
-from numbers import Integral, Real
+from numbers import Integral
 
 import numpy as np
-from joblib import Parallel, delayed, effective_n_jobs
-from sklearn.base import BaseEstimator, RegressorMixin, _fit_context
+from sklearn.base import RegressorMixin, _fit_context
 from sklearn.utils import check_random_state
-from sklearn.utils._param_validation import Interval, StrOptions
-from sklearn.utils.validation import _check_sample_weight, check_is_fitted
+from sklearn.utils._param_validation import Interval
+from sklearn.utils.validation import check_is_fitted
 
-from ._builder import TEST_KINDS, build_tree
-from ._objects import ObjectInputMixin, check_view_bounds
-from ._predictor import apply_leaves, predict_mean
-from ._rows import group_by_type
-from ._tree import BoxTree, PackedForest
+from ._base import _INT32_MAX, BaseBoxTrees
+from ._extra_tree import BoxExtraTreeRegressor
 
 __all__ = ["BoxExtraTreesRegressor"]
 
-# below this many samples, prediction runs in the calling thread
-_PARALLEL_PREDICT_MIN_SAMPLES = 2048
-# y bands of the training-object index: at most this many, this many for large boxes
-_MAX_BANDS = 32
-_DEFAULT_BANDS = 8
 
-
-class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
+class BoxExtraTreesRegressor(RegressorMixin, BaseBoxTrees):
     """Extra-Trees regression over sets of 2D objects, with box-count node tests.
 
     Each sample is a set of objects ``[x, y, type]`` of any size (possibly empty). A node test
@@ -45,9 +35,11 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         Number of trees (M).
     n_tests : int, default=500
         Number of random tests drawn per node (K); the best one is kept.
-    min_samples_split : float, default=30
-        A node whose total sample weight (with unit weights: its number of samples) is below
-        this becomes a leaf (n_min).
+    min_samples_split : int or float, default=30
+        A node with fewer samples than this becomes a leaf (n_min), as in scikit-learn: an
+        int >= 2 is a number of samples, a float in ``(0, 1]`` a fraction of them (rounded
+        up). Samples are counted whatever their weights, so scaling the weights changes
+        nothing.
     test_type : {"fixed", "bounded", "random", "classic"}, default="fixed"
         How test boxes are drawn in the sampling region:
 
@@ -73,19 +65,23 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         means all processors. Trees are built with the GIL released. Results do not depend
         on ``n_jobs``.
     random_state : int, RandomState instance or None, default=None
-        Seeds the trees. The same value gives the same forest whatever ``n_jobs``.
+        Seeds the trees: each gets an int ``random_state`` drawn from it. The same value
+        gives the same forest whatever ``n_jobs``.
     verbose : int, default=0
         Verbosity of the joblib loop over trees.
 
     Attributes
     ----------
-    estimators_ : list of BoxTree
-        The fitted trees, as flat node arrays.
+    estimators_ : list of BoxExtraTreeRegressor
+        The fitted trees (also ``forest[k]``, ``len(forest)``, ``iter(forest)``); their node
+        arrays are ``estimators_[k].tree_``.
+    types_ : ndarray of int
+        Sorted type ids seen at fit (the column indices for a feature matrix). Tests are
+        drawn on these types only; other ids at predict time match no test.
     n_types_ : int
-        Number of object types (one more than the largest type id at fit; the number of
-        columns for a feature matrix). Types seen only at predict time match no test.
+        ``len(types_)``.
     bounds_ : ndarray of shape (n_types_, 4)
-        Sampling region per type.
+        Sampling region per type of ``types_``.
     n_features_in_ : int
         Number of columns, when fitted on a feature matrix.
     feature_names_in_ : ndarray of str
@@ -93,32 +89,39 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
 
     See Also
     --------
+    BoxExtraTreeRegressor : one tree of the forest.
     GridCounts : the fixed-size grid representation, for any scikit-learn regressor.
     sklearn.ensemble.ExtraTreesRegressor : classic Extra-Trees on feature matrices.
 
     Examples
     --------
+    The target counts the objects of type 0 in the unit square around the origin; type 1 is
+    a distractor. The forest learns the count from the sets alone, and only type 0 matters:
+
     >>> import numpy as np
     >>> from boxtrees import BoxExtraTreesRegressor
     >>> rng = np.random.default_rng(0)
-    >>> X = [np.column_stack([rng.uniform(-3, 3, (n, 2)), rng.integers(0, 2, n)])
-    ...      for n in rng.integers(0, 8, 300)]
-    >>> y = [float(((np.abs(s[:, :2]).max(1) < 1) & (s[:, 2] == 0)).sum()) for s in X]
+    >>> def sets(n):
+    ...     return [np.column_stack([rng.uniform(-3, 3, (k, 2)), rng.integers(0, 2, k)])
+    ...             for k in rng.integers(0, 12, n)]
+    >>> def count(s):
+    ...     return float(((np.abs(s[:, :2]).max(1) < 1) & (s[:, 2] == 0)).sum())
+    >>> X, X_test = sets(2000), sets(500)
     >>> forest = BoxExtraTreesRegressor(n_estimators=10, min_samples_split=5,
-    ...                                 random_state=0).fit(X, y)
-    >>> forest.predict(X[:3]).round(2).tolist() == np.round(forest.predict(X)[:3], 2).tolist()
+    ...                                 random_state=0).fit(X, [count(s) for s in X])
+    >>> bool(forest.score(X_test, [count(s) for s in X_test]) > 0.9)
     True
+    >>> forest.types_.tolist(), bool(forest.feature_importances_[0] > 0.9)
+    ([0, 1], True)
+    >>> # a set with one coin at the centre, as many distractors, or nothing
+    >>> centre = [np.array([[0.0, 0.0, 0]]), np.array([[0.0, 0.0, 1]]), np.empty((0, 3))]
+    >>> forest.predict(centre).round().tolist()
+    [1.0, 0.0, 0.0]
     """
 
     _parameter_constraints = {
-        "n_estimators": [Interval(Integral, 1, None, closed="left")],
-        "n_tests": [Interval(Integral, 1, None, closed="left")],
-        "min_samples_split": [Interval(Real, 0, None, closed="left")],
-        "test_type": [StrOptions(set(TEST_KINDS))],
-        "test_width": [Interval(Real, 0, None, closed="neither")],
-        "max_retries": [Interval(Integral, 0, None, closed="left")],
-        "max_depth": [Interval(Integral, 0, None, closed="left"), None],
-        "view_bounds": ["array-like", Interval(Real, 0, None, closed="neither"), None],
+        **BaseBoxTrees._parameter_constraints,
+        "n_estimators": [Interval(Integral, 1, _INT32_MAX, closed="both")],
         "n_jobs": [Integral, None],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
@@ -162,112 +165,33 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         y : array-like of shape (n_samples,)
             Target values.
         sample_weight : array-like of shape (n_samples,), default=None
-            Non-negative weights; a weight of ``k`` acts like ``k`` copies of the sample and
-            zero-weight samples are ignored. None gives every sample weight 1.
+            Non-negative weights, each a sample's share in the node means and variances: zero
+            ignores a sample, and scaling all weights changes nothing. None gives every
+            sample weight 1.
 
         Returns
         -------
         self : BoxExtraTreesRegressor
         """
-        sets, y = self._validate_input(X, y, reset=True, requires_y=True)
-        if not np.isfinite(y).all():
-            raise ValueError("y contains NaN or infinite values")
-        # ``sizes`` stands in for X: one entry per sample, a plain NumPy array
-        sample_weight = _check_sample_weight(
-            sample_weight, sets.sizes, dtype=np.float64, ensure_non_negative=True
-        )
-        keep = sample_weight > 0
-        if not keep.all():
-            sets, y, sample_weight = sets[keep], y[keep], sample_weight[keep]
-
-        data = sets.data
-        types = data[:, 2].astype(np.intp)
-        if self._fitted_on_features:
-            self.n_types_ = self.n_features_in_
-        else:
-            self.n_types_ = int(types.max()) + 1 if len(types) else 1
-        self.bounds_ = self._sampling_region(data)
-        local_x = self._fitted_on_features and self.view_bounds is None
-
-        band_edges = self._band_edges()
-        n_bands = len(band_edges) - 1
-        bands = np.searchsorted(band_edges[1:-1], data[:, 1], side="right")
-        segments = types * n_bands + bands
-        order = np.lexsort((data[:, 0], segments))
-        x_sorted = np.ascontiguousarray(data[order, 0])
-        y_sorted = np.ascontiguousarray(data[order, 1])
-        sample_of = sets.sample_index()[order].astype(np.int32)
-        segment_ptr = np.searchsorted(
-            segments[order], np.arange(self.n_types_ * n_bands + 1)
-        ).astype(np.intp)
-
         rng = check_random_state(self.random_state)
         seeds = rng.randint(np.iinfo(np.int64).max, size=self.n_estimators, dtype=np.int64)
-        max_depth = -1 if self.max_depth is None else self.max_depth
-        trees = Parallel(n_jobs=self.n_jobs, verbose=self.verbose, prefer="threads")(
-            delayed(build_tree)(
-                x_sorted, y_sorted, sample_of, segment_ptr, band_edges, y, sample_weight, self.bounds_,
-                local_x, self._fitted_on_features, self.test_type, float(self.test_width), self.n_tests,
-                float(self.min_samples_split), max_depth, self.max_retries, int(seed),
-            )
-            for seed in seeds
-        )
-        self.estimators_ = [BoxTree(**arrays) for arrays in trees]
-        self._packed = PackedForest(self.estimators_)
+        trees = self._fit_trees(X, y, sample_weight, seeds, self.n_jobs, self.verbose)
+        params = {name: getattr(self, name) for name in BoxExtraTreeRegressor._get_param_names()
+                  if name != "random_state"}
+        fitted = {name: value for name, value in self.__dict__.items()
+                  if name in ("types_", "n_types_", "bounds_", "_fitted_on_features",
+                              "n_features_in_", "feature_names_in_")}
+        self.estimators_ = []
+        for tree, seed in zip(trees, seeds):
+            estimator = BoxExtraTreeRegressor(**params, random_state=int(seed))
+            estimator.__dict__.update(fitted, tree_=tree)
+            estimator._pack([tree])
+            self.estimators_.append(estimator)
+        self._pack(trees)
         return self
 
-    def _sampling_region(self, data):
-        """Region ``(xmin, xmax, ymin, ymax)`` in which tests of each type are drawn."""
-        if self.view_bounds is not None:
-            region = check_view_bounds(self.view_bounds)
-        elif len(data):
-            region = np.array([data[:, 0].min(), data[:, 0].max(), data[:, 1].min(), data[:, 1].max()])
-        else:
-            region = np.array([0.0, 1.0, 0.0, 1.0])
-        bounds = np.tile(region, (self.n_types_, 1))
-        if self._fitted_on_features:
-            bounds[:, 2:] = [-np.inf, np.inf]
-        return np.ascontiguousarray(bounds, dtype=np.float32)
-
-    def _band_edges(self):
-        """Edges of the y bands that index the training objects (an internal speed-up).
-
-        Bands about twice as tall as a fixed or bounded box (measured best) let a test skip
-        most objects of its type; wholly covered bands need no y comparison. Feature-matrix
-        columns have no y.
-        """
-        if self._fitted_on_features:
-            n_bands = 1
-        elif self.test_type in ("fixed", "bounded"):
-            height = float(self.bounds_[0, 3]) - float(self.bounds_[0, 2])
-            n_bands = int(np.clip(np.ceil(height / (4 * self.test_width)), 1, _MAX_BANDS))
-        else:
-            n_bands = _DEFAULT_BANDS
-        y0, y1 = float(self.bounds_[0, 2]), float(self.bounds_[0, 3])
-        inner = y0 + (y1 - y0) * np.arange(1, n_bands) / n_bands
-        return np.concatenate([[-np.inf], inner, [np.inf]])
-
-    def _traverse(self, X, kernel, out):
-        """Validate ``X`` and run a traversal kernel over its samples, in parallel chunks
-        when the batch is large."""
-        if "estimators_" not in self.__dict__:  # cheap test first: predict is called per step
-            check_is_fitted(self)
-        sets, _ = self._validate_input(X, reset=False)
-        samples = group_by_type(sets.data, sets.offsets, self.n_types_)
-        n = len(sets)
-        out = out(n)
-        # chunks of at least half the threshold each; joblib is not even asked for small batches
-        n_jobs = 1
-        if n >= _PARALLEL_PREDICT_MIN_SAMPLES:
-            n_jobs = min(effective_n_jobs(self.n_jobs), n // (_PARALLEL_PREDICT_MIN_SAMPLES // 2))
-        if n_jobs == 1:
-            kernel(self._packed, samples, 0, n, out)
-        else:
-            edges = np.linspace(0, n, n_jobs + 1).astype(np.intp)
-            Parallel(n_jobs=n_jobs, require="sharedmem")(
-                delayed(kernel)(self._packed, samples, a, b, out) for a, b in zip(edges[:-1], edges[1:])
-            )
-        return out
+    def _trees(self):
+        return [e.tree_ for e in self.estimators_] if "estimators_" in self.__dict__ else None
 
     def predict(self, X):
         """Predict the mean of the trees' leaf values.
@@ -280,7 +204,7 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         -------
         y : ndarray of shape (n_samples,)
         """
-        return self._traverse(X, predict_mean, lambda n: np.empty(n, dtype=np.float64))
+        return self._predict_mean(X, self.n_jobs)
 
     def apply(self, X):
         """Index of the leaf each sample reaches in each tree.
@@ -292,30 +216,48 @@ class BoxExtraTreesRegressor(ObjectInputMixin, RegressorMixin, BaseEstimator):
         Returns
         -------
         leaves : ndarray of shape (n_samples, n_estimators)
-            Node ids, local to each tree (as in ``estimators_[k]``).
+            Node ids, local to each tree (as in ``estimators_[k].tree_``).
         """
-        return self._traverse(X, apply_leaves, lambda n: np.empty((n, self.n_estimators), dtype=np.intp))
+        return self._apply(X, self.n_jobs)
+
+    def decision_path(self, X):
+        """The nodes each sample passes through, in every tree.
+
+        Parameters
+        ----------
+        X : object sets or feature matrix, of the kind seen at fit
+
+        Returns
+        -------
+        indicator : sparse matrix of shape (n_samples, n_nodes)
+            1 where a sample passes through a node; the trees' nodes side by side.
+        n_nodes_ptr : ndarray of shape (n_estimators + 1,)
+            Columns ``n_nodes_ptr[k]:n_nodes_ptr[k + 1]`` are tree ``k``'s nodes.
+        """
+        check_is_fitted(self)
+        return self._decision_path(X, self._trees(), self.n_jobs)
 
     @property
     def feature_importances_(self):
-        """Impurity-based importance of each object type (each column for a feature matrix):
-        the weighted variance reduction of the tests on it, normalised per tree, averaged
-        over trees, summing to 1 (all zeros if no tree splits).
+        """Impurity-based importance of each type of ``types_`` (each column for a feature
+        matrix): the weighted variance reduction of the tests on it, normalised per tree,
+        averaged over trees, summing to 1 (all zeros if no tree splits).
 
         Returns
         -------
         importances : ndarray of shape (n_types_,)
         """
         check_is_fitted(self)
-        total = np.mean([t.type_importances(self.n_types_) for t in self.estimators_], axis=0)
+        total = np.mean([t.type_importances(self.types_) for t in self._trees()], axis=0)
         return total / total.sum() if total.sum() > 0 else total
 
-    def __getstate__(self):
-        state = dict(super().__getstate__())  # a copy: object.__getstate__ returns __dict__ itself
-        state.pop("_packed", None)
-        return state
+    def __len__(self):
+        """Number of fitted trees."""
+        return len(self.estimators_)
 
-    def __setstate__(self, state):
-        super().__setstate__(state)
-        if "estimators_" in state:
-            self._packed = PackedForest(self.estimators_)
+    def __getitem__(self, index):
+        """The ``index``-th fitted tree, a `BoxExtraTreeRegressor`."""
+        return self.estimators_[index]
+
+    def __iter__(self):
+        return iter(self.estimators_)

@@ -6,7 +6,7 @@ from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 
-from ._objects import ObjectInputMixin, check_view_bounds
+from ._objects import _MAX_TYPE, ObjectInputMixin, check_view_bounds
 
 __all__ = ["GridCounts"]
 
@@ -15,10 +15,10 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
     """Count the objects of each type in the cells of an ``n_bins x n_bins`` grid.
 
     This is the fixed-size "grid" state representation of the thesis: the view is cut into
-    ``n_bins x n_bins`` equal cells and each sample becomes the ``n_bins * n_bins * n_types``
+    ``n_bins x n_bins`` equal cells and each sample becomes the ``n_bins * n_bins * n_types_``
     vector of per-cell, per-type counts, ordered as a C array of shape
-    ``(n_bins, n_bins, n_types)`` indexed ``[x cell, y cell, type]``. Objects outside the grid
-    and types not seen at fit are ignored.
+    ``(n_bins, n_bins, n_types_)`` indexed ``[x cell, y cell, type]``, the types in the order
+    of ``types_``. Objects outside the grid and types not in ``types_`` are ignored.
 
     A 2D feature matrix is read with column ``j`` as a one-dimensional object of type ``j``:
     each column's range is cut into ``n_bins`` cells and the output is the
@@ -32,12 +32,16 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         Grid extent ``(xmin, xmax, ymin, ymax)``, or a half-width ``r`` for ``[-r, r]^2``.
         None: the bounding box of the objects seen at fit (per column for a feature matrix).
     n_types : int, default=None
-        Number of object types. None: one more than the largest type id seen at fit.
+        Count the type ids ``0 .. n_types - 1`` (a fixed layout, whatever the data). None:
+        count the type ids seen at fit, so the output size follows the types present, not
+        the largest id.
 
     Attributes
     ----------
+    types_ : ndarray of int
+        Sorted type ids counted (the column indices for a feature matrix).
     n_types_ : int
-        Number of object types counted.
+        ``len(types_)``.
     bounds_ : ndarray of shape (n_types_, 4)
         Grid extent used for each type.
     n_features_in_ : int
@@ -56,7 +60,7 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
     _parameter_constraints = {
         "n_bins": [Interval(Integral, 1, None, closed="left")],
         "view_bounds": ["array-like", Interval(Real, 0, None, closed="neither"), None],
-        "n_types": [Interval(Integral, 1, None, closed="left"), None],
+        "n_types": [Interval(Integral, 1, _MAX_TYPE, closed="both"), None],
     }
 
     def __init__(self, n_bins=10, *, view_bounds=None, n_types=None):
@@ -82,6 +86,7 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         sets, _ = self._validate_input(X, reset=True)
         data = sets.data
         if self._fitted_on_features:
+            self.types_ = np.arange(self.n_features_in_)
             self.n_types_ = self.n_features_in_
             if self.view_bounds is None:
                 x = data[:, 0].reshape(len(sets), -1)
@@ -92,9 +97,10 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
                 self.bounds_ = np.tile(check_view_bounds(self.view_bounds), (self.n_types_, 1))
             return self
         if self.n_types is not None:
-            self.n_types_ = self.n_types
+            self.types_ = np.arange(self.n_types)
         else:
-            self.n_types_ = int(data[:, 2].max()) + 1 if len(data) else 1
+            self.types_ = np.unique(data[:, 2].astype(np.intp)) if len(data) else np.zeros(1, np.intp)
+        self.n_types_ = len(self.types_)
         if self.view_bounds is not None:
             bounds = check_view_bounds(self.view_bounds)
         elif len(data):
@@ -127,8 +133,8 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         nx, ny = self._grid_shape()
         n_out = nx * ny * self.n_types_
         data = sets.data
-        types = data[:, 2].astype(np.intp)
-        keep = types < self.n_types_
+        types = np.searchsorted(self.types_, data[:, 2].astype(np.intp))
+        keep = self.types_[np.minimum(types, self.n_types_ - 1)] == data[:, 2]
         types, data, sample = types[keep], data[keep], sets.sample_index()[keep]
         b = self.bounds_[types]
         ix = _cell(data[:, 0], b[:, 0], b[:, 1], nx)
@@ -152,7 +158,7 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
             features = _check_feature_names_in(self, input_features)
             names = [f"{f}_bin{i}" for i in range(nx) for f in features]
         else:
-            names = [f"type{t}_x{i}_y{j}" for i in range(nx) for j in range(ny) for t in range(self.n_types_)]
+            names = [f"type{t}_x{i}_y{j}" for i in range(nx) for j in range(ny) for t in self.types_]
         return np.asarray(names, dtype=object)
 
 

@@ -9,7 +9,7 @@ from numbers import Integral
 import numpy as np
 from scipy.sparse import issparse
 
-from ._rows import RowProblem, scan_rows
+from ._rows import RowProblem, scan_offsets, scan_rows
 
 __all__ = ["ObjectSets"]
 
@@ -25,12 +25,32 @@ def _offsets_from_sizes(sizes):
 
 
 _ROW_PROBLEMS = {
-    RowProblem.ROW_NOT_FINITE: "contain NaN or infinite values",
-    RowProblem.ROW_TOO_LARGE: "have coordinates too large for float32 (|value| > 3.4e38)",
-    RowProblem.ROW_NEGATIVE_TYPE: "have negative type ids; type ids must be integers >= 0",
-    RowProblem.ROW_NON_INTEGER_TYPE: "have non-integer type ids; type ids must be integers >= 0",
-    RowProblem.ROW_TYPE_TOO_LARGE: f"have type ids >= {_MAX_TYPE}, which are not supported",
+    RowProblem.NOT_FINITE: "contain NaN or infinite values",
+    RowProblem.TOO_LARGE: "have coordinates too large for float32 (|value| > 3.4e38)",
+    RowProblem.NEGATIVE_TYPE: "have negative type ids; type ids must be integers >= 0",
+    RowProblem.NON_INTEGER_TYPE: "have non-integer type ids; type ids must be integers >= 0",
+    RowProblem.TYPE_TOO_LARGE: f"have type ids >= {_MAX_TYPE}, which are not supported",
 }
+
+
+def row_error(problem, row, data, what="object sets"):
+    """The ValueError for ``problem`` (a `RowProblem`) at ``row`` of ``data``."""
+    return ValueError(f"{what} {_ROW_PROBLEMS[problem]} (object row {row}: {data[row].tolist()})")
+
+
+def _check_offsets(offsets, n_rows):
+    """Validate batch offsets and return them as a C-contiguous intp array."""
+    offsets = np.asarray(offsets)
+    if offsets.ndim != 1 or offsets.size == 0 or not np.issubdtype(offsets.dtype, np.integer):
+        raise ValueError("offsets must be a non-empty 1D integer array")
+    offsets = np.ascontiguousarray(offsets, dtype=np.intp)
+    bad = scan_offsets(offsets, n_rows)
+    if bad >= 0:
+        raise ValueError(
+            f"offsets must be non-decreasing from 0 to n_objects={n_rows}; got "
+            f"{offsets[bad]} at position {bad} of {len(offsets)}"
+        )
+    return offsets
 
 
 def _check_rows(data, what="object sets"):
@@ -49,16 +69,19 @@ def _check_rows(data, what="object sets"):
         data = data.astype(np.float64, copy=False)
     data = np.ascontiguousarray(data)
     problem, row = scan_rows(data, _FLOAT32_MAX, _MAX_TYPE)
-    if problem != RowProblem.ROW_OK:
-        raise ValueError(f"{what} {_ROW_PROBLEMS[problem]} (object row {row}: {data[row].tolist()})")
+    if problem != RowProblem.OK:
+        raise row_error(problem, row, data, what)
     return data.astype(np.float32, copy=False)
 
 
 class ObjectSets:
     """A batch of object sets stored as one array of rows plus offsets.
 
-    Set ``i`` is ``data[offsets[i]:offsets[i + 1]]``. Building one validates its content once;
-    slicing and indexing return views or compact copies without re-validation.
+    Set ``i`` is ``data[offsets[i]:offsets[i + 1]]``. Building one validates its content;
+    slicing and indexing return views or compact copies without re-validation. The arrays are
+    not frozen (``sets[i]`` is a writable view): the estimators check a batch again each time
+    they are given it, and their kernels check every index they read, so a batch changed
+    after it was built gets a clear error, never an out-of-bounds access.
 
     Parameters
     ----------
@@ -80,17 +103,8 @@ class ObjectSets:
     __slots__ = ("data", "offsets")
 
     def __init__(self, data, offsets):
-        data = _check_rows(data)
-        offsets = np.asarray(offsets)
-        if offsets.ndim != 1 or offsets.size == 0 or not np.issubdtype(offsets.dtype, np.integer):
-            raise ValueError("offsets must be a non-empty 1D integer array")
-        if offsets[0] != 0 or offsets[-1] != len(data) or (np.diff(offsets) < 0).any():
-            raise ValueError(
-                f"offsets must be non-decreasing from 0 to n_objects={len(data)}; "
-                f"got {offsets[0]} ... {offsets[-1]}"
-            )
-        self.data = data
-        self.offsets = np.ascontiguousarray(offsets, dtype=np.intp)
+        self.data = _check_rows(data)
+        self.offsets = _check_offsets(offsets, len(self.data))
 
     @classmethod
     def _trusted(cls, data, offsets):
@@ -118,6 +132,8 @@ class ObjectSets:
                 return cls._trusted(data, np.array([0, len(data)], dtype=np.intp))
         arrays = []
         for i, s in enumerate(sets):
+            if s is None:
+                raise ValueError(f"each object set must be an array of shape (n_objects, 3); set {i} is None")
             a = np.asarray(s)
             if a.size == 0:
                 a = np.empty((0, 3), dtype=np.float32)
@@ -228,30 +244,51 @@ def _is_ragged_batch(X):
     )
 
 
+def _is_set_like(item):
+    """Whether one item of a sequence looks like an object set (2D or empty), without
+    converting it."""
+    ndim = getattr(item, "ndim", None)
+    if ndim is not None:
+        return ndim >= 2 or item.size == 0
+    if isinstance(item, (list, tuple)):
+        return len(item) == 0 or isinstance(item[0], (list, tuple)) or getattr(item[0], "ndim", 0) >= 1
+    return False
+
+
+def _is_sequence_of_items(X):
+    """A list, a tuple, a 1D object array or a pandas Series of objects."""
+    if isinstance(X, (list, tuple)):
+        return True
+    return getattr(X, "ndim", None) == 1 and getattr(X, "dtype", None) == object
+
+
 def is_feature_matrix(X):
     """Whether ``X`` is read as a 2D feature matrix rather than as object sets.
 
     Object sets are an :class:`ObjectSets` (or any object with ``data`` and ``offsets``
     arrays, such as the batched observations of ``envs``), a 3D array
-    ``(n_samples, n_objects, 3)``, or a sequence whose items are 2D arrays (or empty). Anything else (2D arrays, data frames,
-    sparse matrices, lists of rows, and invalid inputs) goes the feature-matrix way, where
-    scikit-learn's own validation reports what is wrong with it.
+    ``(n_samples, n_objects, 3)``, or a sequence (list, tuple, 1D object array, pandas Series)
+    of which any item is a 2D array or empty: the sets path then names the position of every
+    item that is not a set. Anything else (2D arrays, data frames, sparse matrices, lists of
+    rows, and invalid inputs) goes the feature-matrix way, where scikit-learn's own validation
+    reports what is wrong with it.
     """
     if isinstance(X, ObjectSets) or _is_ragged_batch(X):
         return False
-    if isinstance(X, np.ndarray):
-        return not (X.ndim == 3 or (X.ndim == 1 and X.dtype == object))
-    if isinstance(X, (list, tuple)) and len(X) > 0:
-        first = X[0]
-        return not (np.ndim(first) >= 2 or np.size(first) == 0)
+    if isinstance(X, np.ndarray) and X.ndim == 3:
+        return False
+    if _is_sequence_of_items(X):
+        return not (isinstance(X, np.ndarray) or any(_is_set_like(item) for item in X))
     return True
 
 
 def as_object_sets(X):
-    """Return object-set input ``X`` (see :func:`is_feature_matrix`) as validated ObjectSets."""
-    if isinstance(X, ObjectSets):
-        return X
-    if _is_ragged_batch(X):
+    """Return object-set input ``X`` (see :func:`is_feature_matrix`) as validated ObjectSets.
+
+    An ``ObjectSets`` is validated again (its arrays may have changed since it was built; no
+    copy is made when they are still float32 and intp).
+    """
+    if isinstance(X, ObjectSets) or _is_ragged_batch(X):
         return ObjectSets(X.data, X.offsets)
     if isinstance(X, np.ndarray) and X.ndim == 3:
         if X.shape[2] != 3:
@@ -260,7 +297,7 @@ def as_object_sets(X):
             )
         data = _check_rows(X.reshape(-1, 3))
         return ObjectSets._trusted(data, _offsets_from_sizes(np.full(X.shape[0], X.shape[1])))
-    return ObjectSets.from_sequence(X)
+    return ObjectSets.from_sequence(list(X) if hasattr(X, "iloc") else X)
 
 
 def check_view_bounds(view_bounds):
@@ -274,8 +311,13 @@ def check_view_bounds(view_bounds):
             f"view_bounds must be (xmin, xmax, ymin, ymax) of finite numbers or a positive "
             f"half-width; got {view_bounds!r}"
         )
+    if np.abs(bounds).max() > _FLOAT32_MAX:
+        raise ValueError(f"view_bounds must fit in float32 (|value| <= 3.4e38); got {view_bounds!r}")
     if bounds[0] >= bounds[1] or bounds[2] >= bounds[3]:
         raise ValueError(f"view_bounds needs xmin < xmax and ymin < ymax; got {view_bounds!r}")
+    single = bounds.astype(np.float32)
+    if single[0] >= single[1] or single[2] >= single[3]:
+        raise ValueError(f"view_bounds collapses to an empty region in float32; got {view_bounds!r}")
     return bounds
 
 

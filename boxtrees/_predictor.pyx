@@ -1,19 +1,34 @@
 """Forest traversal: predictions and leaf indices for batches of object sets.
 
-The objects of each sample come grouped by type (``boxtrees._rows.group_by_type``), so a node
-test scans only the sample's objects of the tested type. A node's
-test is one 32-byte record (half a cache line) and a left child follows its parent, so a
-root-to-leaf walk touches few cache lines. Samples are processed in blocks, tree by tree, so
-that a tree's nodes stay in cache across a block. The walk itself is a kernel of ``_simd.h``:
-with AVX-512 it tests all of a sample's objects of a type at once.
-"""
-cimport numpy as cnp
+A `PackedForest` holds the node tests of fitted trees as one array of 32-byte records (half a
+cache line; a left child follows its parent, so a root-to-leaf walk touches few cache lines).
+It copies and validates the trees it is built from and keeps its arrays private, so no value
+reachable from Python can send a walk outside them.
 
-from ._utils cimport coord_t, float64_t, intp_t
+The traversal entry points regroup each sample's objects by type first, so a node test scans
+only the sample's objects of the tested type; they re-validate, on every call and at the point
+of use, the rows and offsets they read (a batch may have changed since it was checked), and
+report the first bad row instead of reading past an array. Samples are processed in blocks,
+tree by tree, so that a tree's nodes stay in cache across a block. The walk itself is a kernel
+of ``_simd.h``: with AVX-512 it tests all of a sample's objects of a type at once.
+"""
+import numpy as np
+
+cimport numpy as cnp
+from libc.math cimport INFINITY
+
+from ._utils cimport (
+    BAD_OFFSETS, ROW_OK, ROW_TYPE_TOO_LARGE, TREE_LEAF, coord_t, float64_t, int32, intp_t,
+    row_problem,
+)
 
 cdef extern from "_simd.h":
-    ctypedef struct boxtrees_node:     # the layout of boxtrees._tree.NODE_DTYPE
-        pass
+    ctypedef struct boxtrees_node:
+        int32 left
+        int32 right
+        int32 object_type
+        int32 threshold
+        coord_t box[4]
     ctypedef struct boxtrees_kernels:
         intp_t (*find_leaf)(const boxtrees_node* nodes, const coord_t* x, const coord_t* y,
                             const intp_t* types) noexcept nogil
@@ -24,10 +39,23 @@ cnp.import_array()
 cdef enum:
     BLOCK = 64
 
+# type ids from this one on are never a tree's (boxtrees._objects rejects them at fit)
+cdef double MAX_TYPE = 2.0 ** 24
+
+cdef boxtrees_node _layout
+# the traversal's node record as a NumPy dtype, read off the C struct of _simd.h
+NODE_DTYPE = np.asarray(<boxtrees_node[:1]>&_layout).dtype
+
 # the traversal kernel (see _simd.h)
 cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)
 # what empty object arrays point to: the kernels read nothing through it
 cdef coord_t _NO_OBJECT = 0
+
+_NODE_FIELDS = {  # BoxTree array -> (dtype kind, trailing shape)
+    "children_left": ("i", ()), "children_right": ("i", ()), "object_type": ("i", ()),
+    "threshold": ("i", ()), "box": ("f", (4,)), "value": ("f", ()),
+}
+_INT32 = np.iinfo(np.int32)
 
 
 def _set_simd(bint enabled):
@@ -41,53 +69,205 @@ def _set_simd(bint enabled):
 
 cdef struct ForestView:
     const boxtrees_node* nodes
-    const intp_t* tree_offsets   # first node of each tree in the packed arrays
+    const float64_t* value       # per node (the prediction at leaves)
+    const intp_t* tree_offsets   # first node of each tree
     intp_t n_trees
 
 
-cdef struct SampleView:
-    const coord_t* x             # objects grouped by sample, then by type
-    const coord_t* y
-    const intp_t* type_ptr       # row i: start of each type of sample i, then the end
-    intp_t stride                # n_types + 1
+def _tree_arrays(k, tree):
+    """Tree ``k``'s node arrays, checked for kind and shape."""
+    arrays = {}
+    for name, (kind, tail) in _NODE_FIELDS.items():
+        array = np.asarray(getattr(tree, name, None))
+        if array.dtype.kind not in (kind, "u" if kind == "i" else kind):
+            raise ValueError(f"tree {k}: {name} must be an array of {'integers' if kind == 'i' else 'floats'}, got {array.dtype}")
+        arrays[name] = array
+    n = len(arrays["value"]) if arrays["value"].ndim == 1 else -1
+    if not 0 < n < _INT32.max:
+        raise ValueError(f"tree {k}: value must be a 1D array of 1 to {_INT32.max - 1} nodes")
+    for name, (kind, tail) in _NODE_FIELDS.items():
+        if arrays[name].shape != (n, *tail):
+            raise ValueError(f"tree {k}: {name} has shape {arrays[name].shape}; {n} nodes need {(n, *tail)}")
+    return arrays
 
 
-cdef inline void _views(ForestView* f, SampleView* s, forest, samples):
-    cdef cnp.ndarray nodes = forest.nodes
-    cdef const intp_t[::1] tree_offsets = forest.tree_offsets
-    cdef const coord_t[::1] x = samples[0]
-    cdef const coord_t[::1] y = samples[1]
-    cdef const intp_t[:, ::1] type_ptr = samples[2]
-    if not (cnp.PyArray_IS_C_CONTIGUOUS(nodes) and nodes.itemsize == sizeof(boxtrees_node)):
-        raise ValueError("forest.nodes must be a C-contiguous array of NODE_DTYPE records")
-    f.nodes = <const boxtrees_node*>cnp.PyArray_DATA(nodes)
-    f.tree_offsets = &tree_offsets[0]
-    f.n_trees = tree_offsets.shape[0] - 1
-    s.x = &x[0] if x.shape[0] else &_NO_OBJECT
-    s.y = &y[0] if y.shape[0] else &_NO_OBJECT
-    s.type_ptr = &type_ptr[0, 0] if type_ptr.shape[0] else NULL
-    s.stride = type_ptr.shape[1]
+cdef class PackedForest:
+    """The nodes of several trees as one private array of `NODE_DTYPE` records, plus leaf
+    values, validated once when built.
 
+    Parameters
+    ----------
+    trees : sequence of BoxTree
+        The trees; their arrays are copied.
+    types : array-like of int
+        The sorted, distinct type ids the trees may test; a node's type is stored as its
+        position in ``types``.
 
-cdef void _walk(const ForestView* f, const SampleView* s, intp_t start, intp_t stop,
-                const float64_t* value, float64_t* mean, intp_t* leaves) noexcept nogil:
-    """Walk samples ``start:stop`` through every tree, in blocks, tree by tree.
-
-    Writes the mean leaf value per sample into ``mean`` or, when ``mean`` is NULL, the
-    tree-local leaf ids into the (n_samples, n_trees) array ``leaves``.
+    Raises
+    ------
+    ValueError
+        When a tree's arrays could send a walk anywhere but down to one of its own leaves
+        (child ids out of range or not after their parent's, a tested type not in ``types``,
+        a threshold beyond int32, a NaN box bound) or hold a non-finite value.
     """
-    cdef intp_t n_trees = f.n_trees, block = start, block_end, tree, i, leaf
-    while block < stop:
-        block_end = min(block + <intp_t>BLOCK, stop)
+
+    cdef tuple _arrays          # the private arrays behind the pointers of _view
+    cdef ForestView _view
+    cdef const intp_t* _types
+    cdef readonly intp_t n_trees
+    cdef readonly intp_t n_types
+    cdef bint _dense            # types are 0 .. n_types - 1: an id is its own position
+
+    def __init__(self, trees, types):
+        types = np.array(types, dtype=np.intp).ravel()
+        if types.size == 0 or types[0] < 0 or (np.diff(types) <= 0).any():
+            raise ValueError("types must be sorted, distinct, non-negative type ids")
+        per_tree = [_tree_arrays(k, tree) for k, tree in enumerate(trees)]
+        if not per_tree:
+            raise ValueError("a forest needs at least one tree")
+        counts = np.array([len(a["value"]) for a in per_tree], dtype=np.intp)
+        offsets = np.zeros(len(counts) + 1, dtype=np.intp)
+        np.cumsum(counts, out=offsets[1:])
+        cat = {name: np.concatenate([a[name] for a in per_tree]) for name in _NODE_FIELDS}
+        n_nodes = int(counts.sum())
+        node = np.arange(n_nodes) - np.repeat(offsets[:len(counts)], counts)   # tree-local id
+        size = np.repeat(counts, counts)
+        left = cat["children_left"].astype(np.int64)
+        right = cat["children_right"].astype(np.int64)
+        inner = left != TREE_LEAF
+        position = np.searchsorted(types, cat["object_type"].astype(np.int64))
+        known = types[np.minimum(position, len(types) - 1)] == cat["object_type"]
+        threshold = cat["threshold"].astype(np.int64)
+        problems = [
+            ((~inner & (right != TREE_LEAF)) | (inner & ((left <= node) | (left >= size)
+                                                         | (right <= node) | (right >= size))),
+             "children must be -1 at a leaf, and ids after the node's own and below "
+             "node_count at a split"),
+            (inner & ~known, "tests a type that is not one of the forest's types"),
+            (inner & ((threshold < _INT32.min) | (threshold > _INT32.max)),
+             "has a threshold outside the int32 range"),
+            (inner & np.isnan(cat["box"]).any(axis=1), "has a NaN box bound"),
+            (~np.isfinite(cat["value"]), "has a non-finite value"),
+        ]
+        for bad, what in problems:
+            if bad.any():
+                i = int(np.flatnonzero(bad)[0])
+                tree = int(np.searchsorted(offsets, i, side="right")) - 1
+                raise ValueError(f"tree {tree}, node {node[i]} {what}")
+        nodes = np.zeros(n_nodes, dtype=NODE_DTYPE)
+        nodes["left"] = np.where(inner, left, TREE_LEAF)
+        nodes["right"] = np.where(inner, right, TREE_LEAF)
+        nodes["object_type"] = np.where(inner, position, 0)
+        nodes["threshold"] = np.where(inner, threshold, 0)
+        nodes["box"] = cat["box"]
+        value = np.ascontiguousarray(cat["value"], dtype=np.float64)
+        self._arrays = (nodes, value, offsets, types)
+        self._view.nodes = <const boxtrees_node*>cnp.PyArray_DATA(nodes)
+        self._view.value = <const float64_t*>cnp.PyArray_DATA(value)
+        self._view.tree_offsets = <const intp_t*>cnp.PyArray_DATA(offsets)
+        self._view.n_trees = self.n_trees = len(counts)
+        self._types = <const intp_t*>cnp.PyArray_DATA(types)
+        self.n_types = len(types)
+        self._dense = types.max() == len(types) - 1
+
+    cdef inline intp_t _position(self, intp_t t) noexcept nogil:
+        """Position of type id ``t`` among the forest's types, -1 if it has none."""
+        cdef const intp_t* types = self._types
+        cdef intp_t lo = 0, hi = self.n_types, mid
+        if self._dense:
+            return t if t < self.n_types else -1
+        while lo < hi:
+            mid = (lo + hi) >> 1
+            if types[mid] < t:
+                lo = mid + 1
+            else:
+                hi = mid
+        return lo if lo < self.n_types and types[lo] == t else -1
+
+    cdef tuple _run(self, const coord_t[:, ::1] data, const intp_t[::1] offsets,
+                    float64_t* mean, intp_t* leaves):
+        """Regroup samples ``offsets`` of ``data`` by type and walk them (see `_walk`).
+
+        Returns ``(problem, row)``: ``problem`` is ``ROW_OK``, or what is wrong with data
+        row ``row`` (or ``BAD_OFFSETS`` at offset position ``row``); nothing is walked then.
+        """
+        cdef intp_t[::1] offs = np.array(offsets, dtype=np.intp)    # read once, here
+        cdef intp_t n_sets = offs.shape[0] - 1, n_rows = data.shape[0], stride = self.n_types + 1
+        cdef intp_t i, k, d, pos = 0, row = -1
+        cdef int problem = ROW_OK
+        if data.shape[1] != 3:
+            raise ValueError(f"object rows must have 3 columns [x, y, type], got {data.shape[1]}")
+        for i in range(n_sets + 1):
+            if offs[i] < 0 or offs[i] > n_rows or (i > 0 and offs[i] < offs[i - 1]):
+                return BAD_OFFSETS, i
+        type_ptr_arr = np.zeros((max(n_sets, 0), stride), dtype=np.intp)
+        cdef intp_t[:, ::1] type_ptr = type_ptr_arr
+        cdef intp_t[::1] cursor = np.empty(stride, dtype=np.intp)
+        with nogil:
+            for i in range(n_sets):
+                for k in range(offs[i], offs[i + 1]):
+                    problem = row_problem(data[k, 0], data[k, 1], data[k, 2], INFINITY, MAX_TYPE)
+                    if problem == ROW_TYPE_TOO_LARGE:
+                        problem = ROW_OK       # an id no tree tests
+                        continue
+                    if problem != ROW_OK:
+                        row = k
+                        break
+                    d = self._position(<intp_t>data[k, 2])
+                    if d >= 0:
+                        type_ptr[i, d + 1] += 1
+                if problem != ROW_OK:
+                    break
+                type_ptr[i, 0] = pos
+                for d in range(self.n_types):
+                    pos += type_ptr[i, d + 1]
+                    type_ptr[i, d + 1] = pos
+        if problem != ROW_OK:
+            return problem, row
+        x_arr = np.zeros(pos, dtype=np.float32)
+        y_arr = np.zeros(pos, dtype=np.float32)
+        cdef coord_t[::1] x = x_arr, y = y_arr
+        with nogil:
+            # the rows are read again: every index is re-checked where it is used, so rows
+            # changed in between cannot move a write out of its sample's range
+            for i in range(n_sets):
+                for d in range(self.n_types):
+                    cursor[d] = type_ptr[i, d]
+                for k in range(offs[i], offs[i + 1]):
+                    if not (0 <= data[k, 2] < MAX_TYPE):
+                        continue
+                    d = self._position(<intp_t>data[k, 2])
+                    if d >= 0 and cursor[d] < type_ptr[i, d + 1]:
+                        x[cursor[d]] = data[k, 0]
+                        y[cursor[d]] = data[k, 1]
+                        cursor[d] += 1
+            _walk(&self._view, &x[0] if pos else &_NO_OBJECT, &y[0] if pos else &_NO_OBJECT,
+                  &type_ptr[0, 0] if n_sets > 0 else NULL, stride, n_sets, mean, leaves)
+        return ROW_OK, -1
+
+
+cdef void _walk(const ForestView* forest, const coord_t* x, const coord_t* y, const intp_t* type_ptr,
+                intp_t stride, intp_t n_samples, float64_t* mean, intp_t* leaves) noexcept nogil:
+    """Walk every sample through every tree, in blocks, tree by tree.
+
+    Sample ``i``'s objects of type position ``d`` are ``x[type_ptr[i * stride + d]:type_ptr[i
+    * stride + d + 1]]`` (and ``y``). Writes the mean leaf value per sample into ``mean`` or,
+    when ``mean`` is NULL, the tree-local leaf ids into the (n_samples, n_trees) ``leaves``.
+    """
+    cdef const boxtrees_node* nodes = forest.nodes
+    cdef const intp_t* tree_offsets = forest.tree_offsets
+    cdef const float64_t* value = forest.value
+    cdef intp_t n_trees = forest.n_trees, block = 0, block_end, tree, i, leaf
+    while block < n_samples:
+        block_end = min(block + <intp_t>BLOCK, n_samples)
         if mean != NULL:
             for i in range(block, block_end):
                 mean[i] = 0.0
         for tree in range(n_trees):
             for i in range(block, block_end):
-                leaf = _kernels.find_leaf(f.nodes + f.tree_offsets[tree], s.x, s.y,
-                                          s.type_ptr + i * s.stride)
+                leaf = _kernels.find_leaf(nodes + tree_offsets[tree], x, y, type_ptr + i * stride)
                 if mean != NULL:
-                    mean[i] += value[f.tree_offsets[tree] + leaf]
+                    mean[i] += value[tree_offsets[tree] + leaf]
                 else:
                     leaves[i * n_trees + tree] = leaf
         if mean != NULL:
@@ -96,24 +276,23 @@ cdef void _walk(const ForestView* f, const SampleView* s, intp_t start, intp_t s
         block = block_end
 
 
-def predict_mean(forest, samples, intp_t start, intp_t stop, float64_t[::1] out):
-    """Write the mean leaf value over the trees for samples ``start:stop`` into ``out``.
+def predict_mean(PackedForest forest, const coord_t[:, ::1] data, const intp_t[::1] offsets,
+                 float64_t[::1] out):
+    """Write the mean leaf value over the trees of each sample into ``out``.
 
-    ``forest`` carries the packed node arrays (see ``boxtrees._tree.PackedForest``) and
-    ``samples`` is the triple returned by ``boxtrees._rows.group_by_type``.
+    Sample ``i`` is ``data[offsets[i]:offsets[i + 1]]`` (rows ``[x, y, type]``); ``out`` has
+    one entry per sample. Returns ``(problem, row)`` as ``PackedForest._run``.
     """
-    cdef ForestView f
-    cdef SampleView s
-    cdef const float64_t[::1] value = forest.value
-    _views(&f, &s, forest, samples)
-    with nogil:
-        _walk(&f, &s, start, stop, &value[0], &out[0], NULL)
+    if out.shape[0] != offsets.shape[0] - 1:
+        raise ValueError(f"out has {out.shape[0]} entries for {offsets.shape[0] - 1} samples")
+    return forest._run(data, offsets, &out[0] if out.shape[0] else NULL, NULL)
 
 
-def apply_leaves(forest, samples, intp_t start, intp_t stop, intp_t[:, ::1] out):
-    """Write the tree-local leaf index of samples ``start:stop`` in every tree into ``out``."""
-    cdef ForestView f
-    cdef SampleView s
-    _views(&f, &s, forest, samples)
-    with nogil:
-        _walk(&f, &s, start, stop, NULL, NULL, &out[0, 0])
+def apply_leaves(PackedForest forest, const coord_t[:, ::1] data, const intp_t[::1] offsets,
+                 intp_t[:, ::1] out):
+    """Write the tree-local leaf index of each sample in every tree into ``out`` of shape
+    (n_samples, n_trees). Returns ``(problem, row)`` as ``PackedForest._run``."""
+    if out.shape[0] != offsets.shape[0] - 1 or out.shape[1] != forest.n_trees:
+        raise ValueError(f"out has shape {tuple(out.shape)[:2]}; expected "
+                         f"({offsets.shape[0] - 1}, {forest.n_trees})")
+    return forest._run(data, offsets, NULL, &out[0, 0] if out.shape[0] else NULL)

@@ -1,4 +1,4 @@
-"""Fitted box-test trees as flat node arrays, and their packed form for traversal."""
+"""Fitted box-test trees as flat node arrays."""
 import numpy as np
 
 __all__ = ["BoxTree", "TREE_LEAF", "TREE_UNDEFINED"]
@@ -42,6 +42,9 @@ class BoxTree:
         Weighted target variance of the node's training samples.
     n_node_samples, weighted_n_node_samples : ndarray of shape (node_count,)
         Number and total weight of training samples reaching each node.
+
+    The arrays are read-only copies: an estimator predicts with the trees as they were fitted
+    (or unpickled, which validates them again); build a new ``BoxTree`` to change one.
     """
 
     def __init__(self, **arrays):
@@ -49,7 +52,20 @@ class BoxTree:
         if missing:
             raise TypeError(f"missing node arrays: {sorted(missing)}")
         for name in _NODE_ARRAYS:
-            setattr(self, name, arrays[name])
+            array = np.array(arrays[name])
+            array.flags.writeable = False
+            setattr(self, name, array)
+
+    @classmethod
+    def from_positions(cls, arrays, types):
+        """A tree from the builder's arrays, whose tested types are positions in ``types``."""
+        inner = arrays["children_left"] != TREE_LEAF
+        arrays["object_type"] = np.where(inner, types[np.where(inner, arrays["object_type"], 0)],
+                                         TREE_UNDEFINED).astype(np.int32)
+        return cls(**arrays)
+
+    def __setstate__(self, state):
+        self.__init__(**state)
 
     @property
     def node_count(self):
@@ -66,49 +82,33 @@ class BoxTree:
         """Length of the longest root-to-leaf path."""
         return int(self.node_depth().max())
 
+    def parents(self):
+        """Parent of every node (-1 at the root), shape (node_count,)."""
+        parent = np.full(self.node_count, TREE_LEAF, dtype=np.intp)
+        inner = np.flatnonzero(self.children_left != TREE_LEAF)
+        parent[self.children_left[inner]] = inner
+        parent[self.children_right[inner]] = inner
+        return parent
+
     def node_depth(self):
         """Depth of every node (root 0), shape (node_count,)."""
         depth = np.zeros(self.node_count, dtype=np.intp)
+        parent = self.parents()
         # children always have larger ids than their parent (depth-first numbering)
-        for node in range(self.node_count):
-            if self.children_left[node] != TREE_LEAF:
-                depth[self.children_left[node]] = depth[self.children_right[node]] = depth[node] + 1
+        for node in range(1, self.node_count):
+            depth[node] = depth[parent[node]] + 1
         return depth
 
-    def type_importances(self, n_types):
-        """Weighted variance reduction of the tests on each type, normalised to sum to 1
-        (all zeros for a single-leaf tree), shape (n_types,)."""
+    def type_importances(self, types):
+        """Weighted variance reduction of the tests on each of ``types`` (sorted type ids),
+        normalised to sum to 1 (all zeros for a single-leaf tree), shape (len(types),)."""
         inner = np.flatnonzero(self.children_left != TREE_LEAF)
         w, imp = self.weighted_n_node_samples, self.impurity
         left, right = self.children_left[inner], self.children_right[inner]
         decrease = w[inner] * imp[inner] - w[left] * imp[left] - w[right] * imp[right]
-        total = np.bincount(self.object_type[inner], weights=decrease, minlength=n_types)
+        position = np.searchsorted(types, self.object_type[inner])
+        total = np.bincount(position, weights=decrease, minlength=len(types))
         return total / total.sum() if total.sum() > 0 else total
 
     def __repr__(self):
         return f"BoxTree(node_count={self.node_count}, n_leaves={self.n_leaves})"
-
-
-# One node test as the Cython traversal reads it: 32 bytes, child ids local to the tree.
-NODE_DTYPE = np.dtype(
-    [("left", np.int32), ("right", np.int32), ("object_type", np.int32),
-     ("threshold", np.int32), ("box", np.float32, (4,))]
-)
-
-
-class PackedForest:
-    """The nodes of several trees as one array of ``NODE_DTYPE`` records, plus leaf values.
-
-    ``tree_offsets[k]`` is the position of tree ``k``'s root; child ids stay tree-local.
-    This is the layout the Cython traversal reads.
-    """
-
-    def __init__(self, trees):
-        self.tree_offsets = np.zeros(len(trees) + 1, dtype=np.intp)
-        np.cumsum([t.node_count for t in trees], out=self.tree_offsets[1:])
-        self.nodes = np.empty(self.tree_offsets[-1], dtype=NODE_DTYPE)
-        for field, name in [("left", "children_left"), ("right", "children_right"),
-                            ("object_type", "object_type"), ("threshold", "threshold"),
-                            ("box", "box")]:
-            self.nodes[field] = np.concatenate([getattr(t, name) for t in trees])
-        self.value = np.concatenate([t.value for t in trees])

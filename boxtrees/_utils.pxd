@@ -1,4 +1,5 @@
 # Shared C-level types and the per-tree random number generator of the Cython core.
+from libc.math cimport floor, isfinite
 from libc.stdint cimport int32_t, int64_t, uint8_t, uint64_t
 
 ctypedef float coord_t        # object coordinates and box bounds
@@ -11,6 +12,34 @@ ctypedef uint64_t uint64
 cdef enum:
     TREE_LEAF = -1            # children_* of a leaf
     TREE_UNDEFINED = -2       # object_type / threshold of a leaf
+
+cdef enum RowProblem:
+    # what is wrong with an object row [x, y, type] (or with a batch's offsets), checked in
+    # this order; boxtrees._objects words them
+    ROW_OK = 0
+    ROW_NOT_FINITE = 1
+    ROW_TOO_LARGE = 2
+    ROW_NEGATIVE_TYPE = 3
+    ROW_NON_INTEGER_TYPE = 4
+    ROW_TYPE_TOO_LARGE = 5
+    BAD_OFFSETS = 6
+
+
+cdef inline int row_problem(double x, double y, double t, double max_coordinate,
+                            double max_type) noexcept nogil:
+    """The first ``ROW_*`` problem of one object row, or ``ROW_OK``."""
+    if not (isfinite(x) and isfinite(y) and isfinite(t)):
+        return ROW_NOT_FINITE
+    if x > max_coordinate or x < -max_coordinate or y > max_coordinate or y < -max_coordinate:
+        return ROW_TOO_LARGE
+    if t < 0:
+        return ROW_NEGATIVE_TYPE
+    if t != floor(t):
+        return ROW_NON_INTEGER_TYPE
+    if t >= max_type:
+        return ROW_TYPE_TOO_LARGE
+    return ROW_OK
+
 
 cdef enum TestKind:
     RANDOM = 0

@@ -20,6 +20,7 @@ _builder = importlib.import_module("boxtrees._builder")
 _predictor = importlib.import_module("boxtrees._predictor")
 _rows = importlib.import_module("boxtrees._rows")
 _tree = importlib.import_module("boxtrees._tree")
+_NODE_ARRAYS = _tree._NODE_ARRAYS
 
 
 def training_arrays(rng, n, per_sample, n_types, n_bands, spread):
@@ -58,11 +59,12 @@ def main():
                 _predictor._set_simd(simd)
                 trees = [_tree.BoxTree(**_builder.build_tree(
                     x, y, sample, segment_ptr, edges, target, weight, bounds, False, False,
-                    test_type, 0.7, 20, 2.0, -1, 2, seed)) for seed in range(3)]
-                forest = _tree.PackedForest(trees)
-                samples = _rows.group_by_type(data, offsets, n_types)
-                _predictor.predict_mean(forest, samples, 0, n, np.empty(n))
-                _predictor.apply_leaves(forest, samples, 0, n, np.empty((n, 3), dtype=np.intp))
+                    test_type, 0.7, 20, 2, -1, 2, seed)) for seed in range(3)]
+                forest = _predictor.PackedForest(trees, np.arange(n_types))
+                assert _predictor.predict_mean(forest, data, offsets, np.empty(n)) == (0, -1)
+                leaves = np.empty((n, 3), dtype=np.intp)
+                assert _predictor.apply_leaves(forest, data, offsets, leaves) == (0, -1)
+                corrupted_inputs(forest, trees, data, offsets)
             assert _rows.scan_rows(data, 3e38, 2**24)[0] == 0, case
     # one object per sample and type: the strip-sum scoring path
     n, n_features = 80, 3
@@ -75,8 +77,47 @@ def main():
     for test_type in ("classic", "random", "fixed"):
         _builder.build_tree(x, np.zeros_like(x), sample, segment_ptr, np.array([-np.inf, np.inf]),
                             rng.normal(size=n), np.ones(n), bounds, True, True, test_type, 0.3,
-                            n_features, 2.0, -1, 2, 1)
+                            n_features, 2, -1, 2, 1)
     print("kernels ok")
+
+
+def corrupted_inputs(forest, trees, data, offsets):
+    """Inputs a validated batch or tree may turn into: each kernel reports them (a problem
+    code, or a ValueError), and reads or writes nothing outside its arrays."""
+    n = len(offsets) - 1
+    out = np.empty(n)
+    rows = data.copy()
+    if len(rows):
+        rows[len(rows) // 2, 2] = -1000.0
+        assert _predictor.predict_mean(forest, rows, offsets, out)[0] != 0
+        rows[len(rows) // 2, 2] = 2.0 ** 30       # an id no tree tests: not a problem
+        assert _predictor.predict_mean(forest, rows, offsets, out)[0] == 0
+    for bad in ([0, len(data) + 1], [-1, 0], [0, 1, 0] if len(data) else [1, 0]):
+        bad = np.array(bad, dtype=np.intp)
+        assert _predictor.predict_mean(forest, data, bad, np.empty(len(bad) - 1))[0] != 0
+    raised = 0
+    for change in ({"children_left": 10**6}, {"children_left": 0}, {"object_type": 99},
+                   {"threshold": 2**40}, {"box": np.nan}, {"value": np.inf}):
+        arrays = {name: np.array(getattr(trees[0], name)) for name in _NODE_ARRAYS}
+        (name, value), = change.items()
+        arrays[name] = arrays[name].astype(np.float64 if name in ("box", "value") else np.int64)
+        arrays[name][0] = value
+        try:
+            _predictor.PackedForest([_tree.BoxTree(**arrays)], np.arange(4))
+        except ValueError:
+            raised += 1
+    # a single-leaf tree has no inner node whose test or children could be bad
+    assert raised == 6 or trees[0].node_count == 1, raised
+    sample = np.array(trees[0].children_left)   # not a sample id: out of range for some
+    try:
+        _builder.build_tree(np.zeros(len(sample), np.float32), np.zeros(len(sample), np.float32),
+                            sample, [0, len(sample)], [-np.inf, np.inf], np.zeros(2), np.ones(2),
+                            np.zeros((1, 4), np.float32), False, False, "fixed", 1.0, 5, 2, -1,
+                            1, 0)
+    except ValueError:
+        pass
+    else:
+        raise AssertionError("build_tree accepted sample ids out of range")
 
 
 if __name__ == "__main__":

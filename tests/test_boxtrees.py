@@ -20,6 +20,11 @@ def random_sets(rng, n, max_objects=10, n_types=4, extent=5.0):
     ]
 
 
+def trees_of(forest):
+    """The node arrays of a forest's trees."""
+    return [estimator.tree_ for estimator in forest]
+
+
 def reference_leaf(tree, objects):
     """Walk one tree in plain NumPy, reading only its exported node arrays."""
     objects = np.asarray(objects, dtype=np.float32).reshape(-1, 3)
@@ -51,17 +56,18 @@ def test_predict_matches_numpy_reference_traversal(test_type, traversal_kernel):
         n_estimators=7, n_tests=20, min_samples_split=4, test_type=test_type,
         test_width=1.5, random_state=0,
     ).fit(X, y)
+    trees = trees_of(forest)
     # unseen type 9 at predict time must match no test; sets with more objects of a type than
     # the SIMD kernel tests at once (16)
     X_new = (random_sets(rng, 300, n_types=10) + [np.empty((0, 3))]
              + random_sets(rng, 50, max_objects=80, n_types=2))
-    leaves = np.array([[reference_leaf(t, s) for t in forest.estimators_] for s in X_new])
+    leaves = np.array([[reference_leaf(t, s) for t in trees] for s in X_new])
     expected = np.mean(
-        [[t.value[leaf] for t, leaf in zip(forest.estimators_, row)] for row in leaves], axis=1
+        [[t.value[leaf] for t, leaf in zip(trees, row)] for row in leaves], axis=1
     )
     np.testing.assert_array_equal(forest.apply(X_new), leaves)
     np.testing.assert_allclose(forest.predict(X_new), expected, rtol=1e-12)
-    assert all(t.node_count > 20 for t in forest.estimators_)
+    assert all(t.node_count > 20 for t in trees_of(forest))
 
 
 def test_node_arrays_are_consistent_with_training_data():
@@ -70,7 +76,7 @@ def test_node_arrays_are_consistent_with_training_data():
     forest = BoxExtraTreesRegressor(n_estimators=3, n_tests=30, min_samples_split=10, random_state=0)
     forest.fit(X, y)
     leaves = forest.apply(X)
-    for k, tree in enumerate(forest.estimators_):
+    for k, tree in enumerate(trees_of(forest)):
         inner = tree.children_left != -1
         left, right = tree.children_left[inner], tree.children_right[inner]
         np.testing.assert_array_equal(
@@ -94,7 +100,7 @@ def test_box_shapes_follow_test_type(test_type, width):
         n_estimators=3, n_tests=10, min_samples_split=5, test_type=test_type,
         test_width=width or 1.0, view_bounds=bounds, random_state=0,
     ).fit(X, y)
-    boxes = np.concatenate([t.box[t.children_left != -1] for t in forest.estimators_]).astype(float)
+    boxes = np.concatenate([t.box[t.children_left != -1] for t in trees_of(forest)]).astype(float)
     sizes = boxes[:, [1, 3]] - boxes[:, [0, 2]]
     if test_type == "fixed":
         np.testing.assert_allclose(sizes, 2 * width, atol=1e-5)
@@ -181,12 +187,14 @@ def test_input_forms_give_identical_forests():
     np.testing.assert_array_equal(from_list.predict(cube), from_list.predict(list(cube)))
 
 
-def test_integer_weights_act_as_repeated_samples():
+def test_integer_weights_act_as_repeated_samples_in_fully_grown_trees():
+    # min_samples_split counts samples, as in scikit-learn: repeating a sample k times and
+    # giving it weight k then grow the same trees only when nodes split down to 2 samples
     rng = np.random.default_rng(4)
     sets = random_sets(rng, 150)
     y = rng.normal(size=150)
     weights = rng.integers(0, 4, 150)
-    params = dict(n_estimators=3, n_tests=20, min_samples_split=6, random_state=0)
+    params = dict(n_estimators=3, n_tests=20, min_samples_split=2, random_state=0)
     weighted = BoxExtraTreesRegressor(**params).fit(sets, y, sample_weight=weights)
     repeated = BoxExtraTreesRegressor(**params).fit(
         [s for s, w in zip(sets, weights) for _ in range(w)], np.repeat(y, weights)
@@ -194,19 +202,56 @@ def test_integer_weights_act_as_repeated_samples():
     np.testing.assert_allclose(weighted.predict(sets), repeated.predict(sets), rtol=1e-10)
 
 
+@pytest.mark.parametrize("min_samples_split", [10, 0.05])
+def test_trees_do_not_depend_on_the_scale_of_the_weights(min_samples_split):
+    rng = np.random.default_rng(6)
+    sets = random_sets(rng, 300)
+    y = rng.normal(size=300)
+    weights = rng.uniform(0.5, 2.0, 300)
+    params = dict(n_estimators=3, n_tests=20, min_samples_split=min_samples_split, random_state=0)
+    reference = BoxExtraTreesRegressor(**params).fit(sets, y, sample_weight=weights)
+    halved = BoxExtraTreesRegressor(**params).fit(sets, y, sample_weight=0.5 * weights)
+    normalised = BoxExtraTreesRegressor(**params).fit(sets, y, sample_weight=weights / weights.sum())
+    for other in (halved, normalised):
+        for a, b in zip(trees_of(reference), trees_of(other)):
+            np.testing.assert_array_equal(a.children_left, b.children_left)
+            np.testing.assert_array_equal(a.box, b.box)
+        np.testing.assert_allclose(other.predict(sets), reference.predict(sets), rtol=1e-9)
+    assert min(t.node_count for t in trees_of(reference)) > 20
+
+
+def test_min_samples_split_counts_samples_or_a_fraction_of_them():
+    from sklearn.datasets import load_diabetes
+
+    X, y = load_diabetes(return_X_y=True)
+    w = np.random.default_rng(0).uniform(0.5, 1.5, len(y))
+    # fully grown trees fit the training data whatever the scale of the weights
+    forest = BoxExtraTreesRegressor(n_estimators=3, min_samples_split=2, test_type="classic",
+                                    random_state=0)
+    assert forest.fit(X, y, sample_weight=w / w.sum()).score(X, y) > 0.999
+    # a node of fewer than 0.1 * 442 = 44.2 samples (45, rounded up) is a leaf
+    params = dict(n_estimators=2, test_type="classic", random_state=0)
+    fraction = BoxExtraTreesRegressor(min_samples_split=0.1, **params).fit(X, y)
+    count = BoxExtraTreesRegressor(min_samples_split=45, **params).fit(X, y)
+    for tree, same in zip(trees_of(fraction), trees_of(count)):
+        inner = tree.children_left != -1
+        assert tree.n_node_samples[inner].min() >= 45 and inner.sum() > 5
+        np.testing.assert_array_equal(tree.children_left, same.children_left)
+
+
 def test_constant_target_and_objectless_data_give_single_leaf_trees():
     forest = BoxExtraTreesRegressor(n_estimators=2).fit([np.empty((0, 3))] * 50, np.arange(50.0))
-    assert all(t.node_count == 1 for t in forest.estimators_)
+    assert all(t.node_count == 1 for t in trees_of(forest))
     np.testing.assert_allclose(forest.predict([np.array([[0.0, 0.0, 0]])]), 24.5)
     rng = np.random.default_rng(5)
     forest = BoxExtraTreesRegressor(n_estimators=2).fit(random_sets(rng, 60), np.full(60, 3.0))
-    assert all(t.node_count == 1 for t in forest.estimators_)
+    assert all(t.node_count == 1 for t in trees_of(forest))
 
 
 def test_max_depth_limits_trees():
     X, y = make_box_regression(500, random_state=0)
     forest = BoxExtraTreesRegressor(n_estimators=3, max_depth=3, min_samples_split=2, random_state=0).fit(X, y)
-    assert max(t.max_depth for t in forest.estimators_) == 3
+    assert max(t.max_depth for t in trees_of(forest)) == 3
 
 
 def test_simd_and_portable_kernels_grow_identical_trees():
@@ -220,7 +265,7 @@ def test_simd_and_portable_kernels_grow_identical_trees():
     finally:
         _builder._set_simd(True)
     simd = BoxExtraTreesRegressor(test_type="random", **params).fit(X, y)
-    for a, b in zip(portable.estimators_, simd.estimators_):
+    for a, b in zip(trees_of(portable), trees_of(simd)):
         np.testing.assert_array_equal(a.children_left, b.children_left)
         np.testing.assert_array_equal(a.box, b.box)
         np.testing.assert_array_equal(a.value, b.value)

@@ -153,7 +153,7 @@ def _attention(params, budget, seed, samples):
     world_seed, observation = _busy_reference_view(params)
     actions = []
     for forest in agent.q_functions_:
-        tests = np.concatenate([_tree_tests(tree) for tree in forest.estimators_])
+        tests = np.concatenate([_tree_tests(tree.tree_) for tree in forest.estimators_])
         top = tests[np.argsort(-tests[:, 7])[:_TOP_TESTS]]
         usage = np.bincount(tests[:, 4].astype(int), weights=tests[:, 6],
                             minlength=agent.rules.n_types)

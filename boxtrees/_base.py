@@ -1,0 +1,228 @@
+"""What the box-test tree estimators share: parameters, growing trees, walking them."""
+from math import ceil
+from numbers import Integral, Real
+
+import numpy as np
+from joblib import Parallel, delayed, effective_n_jobs
+from scipy.sparse import csr_matrix
+from sklearn.base import BaseEstimator
+from sklearn.utils._param_validation import Interval, RealNotInt, StrOptions
+from sklearn.utils.validation import _check_sample_weight, check_is_fitted
+
+from ._builder import TEST_KINDS, build_tree
+from ._objects import ObjectInputMixin, check_view_bounds, row_error
+from ._predictor import PackedForest, apply_leaves, predict_mean
+from ._rows import RowProblem
+from ._tree import BoxTree
+
+# below this many samples, prediction runs in the calling thread
+_PARALLEL_PREDICT_MIN_SAMPLES = 2048
+# y bands of the training-object index: at most this many, this many for large boxes
+_MAX_BANDS = 32
+_DEFAULT_BANDS = 8
+# counts, ids and loop bounds of the Cython core are 32-bit
+_INT32_MAX = 2**31 - 1
+
+
+class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
+    """Parameters, fitting and traversal shared by a box-test tree and a forest of them.
+
+    Fitting sets ``types_`` (the sorted type ids seen, or the column indices of a feature
+    matrix), ``n_types_``, ``bounds_`` and the private ``_packed`` form the traversal reads
+    (rebuilt, and so validated again, when unpickled).
+    """
+
+    _parameter_constraints = {
+        "n_tests": [Interval(Integral, 1, _INT32_MAX, closed="both")],
+        "min_samples_split": [
+            Interval(Integral, 2, None, closed="left"),
+            Interval(RealNotInt, 0.0, 1.0, closed="right"),
+        ],
+        "test_type": [StrOptions(set(TEST_KINDS))],
+        "test_width": [Interval(Real, 0, None, closed="neither")],
+        "max_retries": [Interval(Integral, 0, _INT32_MAX, closed="both")],
+        "max_depth": [Interval(Integral, 0, _INT32_MAX, closed="both"), None],
+        "view_bounds": ["array-like", Interval(Real, 0, None, closed="neither"), None],
+    }
+
+    def _fit_trees(self, X, y, sample_weight, seeds, n_jobs=None, verbose=0):
+        """Validate the training data, set the fitted attributes and grow one tree per seed."""
+        sets, y = self._validate_input(X, y, reset=True, requires_y=True)
+        if not np.isfinite(y).all():
+            raise ValueError("y contains NaN or infinite values")
+        # ``sizes`` stands in for X: one entry per sample, a plain NumPy array
+        sample_weight = _check_sample_weight(
+            sample_weight, sets.sizes, dtype=np.float64, ensure_non_negative=True
+        )
+        keep = sample_weight > 0
+        if not keep.all():
+            sets, y, sample_weight = sets[keep], y[keep], sample_weight[keep]
+        if len(sets) > _INT32_MAX - 1:
+            raise ValueError(f"at most {_INT32_MAX - 1} samples are supported, got {len(sets)}")
+        objects = _TrainingObjects(self, sets)
+        split = self.min_samples_split
+        min_samples = split if isinstance(split, Integral) else max(2, ceil(split * len(sets)))
+        max_depth = -1 if self.max_depth is None else self.max_depth
+        trees = Parallel(n_jobs=n_jobs, verbose=verbose, prefer="threads")(
+            delayed(build_tree)(
+                objects.x, objects.y, objects.sample_of, objects.segment_ptr, objects.band_edges,
+                y, sample_weight, objects.bounds, objects.local_x, self._fitted_on_features,
+                self.test_type, float(self.test_width), self.n_tests, min_samples, max_depth,
+                self.max_retries, int(seed),
+            )
+            for seed in seeds
+        )
+        return [BoxTree.from_positions(arrays, self.types_) for arrays in trees]
+
+    def _pack(self, trees):
+        self._packed = PackedForest(trees, self.types_)
+
+    def _traverse(self, X, kernel, out, n_jobs=None):
+        """Validate ``X`` and run a traversal kernel over its samples into ``out(n)``, in
+        parallel chunks when the batch is large."""
+        if "_packed" not in self.__dict__:  # cheap test first: predict is called per step
+            check_is_fitted(self)
+        sets, _ = self._validate_input(X, reset=False)
+        n = len(sets)
+        out = out(n)
+        # chunks of at least half the threshold each; joblib is not even asked for small batches
+        n_chunks = 1
+        if n >= _PARALLEL_PREDICT_MIN_SAMPLES:
+            n_chunks = min(effective_n_jobs(n_jobs), n // (_PARALLEL_PREDICT_MIN_SAMPLES // 2))
+        if n_chunks == 1:
+            results = [kernel(self._packed, sets.data, sets.offsets, out)]
+        else:
+            edges = np.linspace(0, n, n_chunks + 1).astype(np.intp)
+            results = Parallel(n_jobs=n_chunks, require="sharedmem")(
+                delayed(kernel)(self._packed, sets.data, sets.offsets[a : b + 1], out[a:b])
+                for a, b in zip(edges[:-1], edges[1:])
+            )
+        for problem, row in results:
+            if problem == RowProblem.BAD_OFFSETS:
+                raise ValueError("the offsets of X changed while it was being read")
+            if problem != RowProblem.OK:
+                raise row_error(problem, row, sets.data, "X changed after it was validated: its rows")
+        return out
+
+    def _predict_mean(self, X, n_jobs=None):
+        return self._traverse(X, predict_mean, lambda n: np.empty(n, dtype=np.float64), n_jobs)
+
+    def _apply(self, X, n_jobs=None):
+        n_trees = self._packed.n_trees if "_packed" in self.__dict__ else 0
+        return self._traverse(X, apply_leaves, lambda n: np.empty((n, n_trees), dtype=np.intp), n_jobs)
+
+    def _decision_path(self, X, trees, n_jobs=None):
+        """Indicator of the nodes each sample passes through, all trees side by side, and the
+        column where each tree's nodes start."""
+        leaves = self._apply(X, n_jobs)
+        starts = np.zeros(len(trees) + 1, dtype=np.intp)
+        np.cumsum([tree.node_count for tree in trees], out=starts[1:])
+        rows, cols = [], []
+        for k, tree in enumerate(trees):
+            parent = tree.parents()
+            node, sample = leaves[:, k].copy(), np.arange(len(leaves))
+            while node.size:        # up from the leaves; ids fall toward the root
+                rows.append(sample)
+                cols.append(node + starts[k])
+                up = parent[node]
+                sample, node = sample[up >= 0], up[up >= 0]
+        rows, cols = np.concatenate(rows), np.concatenate(cols)
+        indicator = csr_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)),
+                               shape=(len(leaves), starts[-1]))
+        indicator.sort_indices()
+        return indicator, starts
+
+    def __getstate__(self):
+        state = dict(super().__getstate__())  # a copy: object.__getstate__ returns __dict__ itself
+        state.pop("_packed", None)
+        return state
+
+    def __setstate__(self, state):
+        super().__setstate__(state)
+        trees = self._trees()
+        if trees is not None:
+            self._pack(trees)
+
+
+class _TrainingObjects:
+    """The training objects indexed for the tree builder.
+
+    Objects are grouped into segments, one per (type position, y band), and sorted by x in
+    each; ``sample_of`` is the sample of each object. Sets the estimator's ``types_``,
+    ``n_types_`` and ``bounds_``.
+    """
+
+    def __init__(self, estimator, sets):
+        data = sets.data
+        features = estimator._fitted_on_features
+        if features:
+            estimator.types_ = np.arange(estimator.n_features_in_)
+            position = None
+        else:
+            estimator.types_, position = np.unique(data[:, 2].astype(np.intp), return_inverse=True)
+            if not len(estimator.types_):
+                estimator.types_ = np.zeros(1, dtype=np.intp)
+        estimator.n_types_ = len(estimator.types_)
+        estimator.bounds_ = self.bounds = _sampling_region(estimator, data)
+        self.local_x = features and estimator.view_bounds is None
+        if features:
+            self._index_columns(data[:, 0].reshape(len(sets), -1))
+        else:
+            self._index_objects(estimator, sets, position)
+
+    def _index_objects(self, estimator, sets, position):
+        data = sets.data
+        self.band_edges = _band_edges(estimator)
+        n_bands = len(self.band_edges) - 1
+        bands = np.searchsorted(self.band_edges[1:-1], data[:, 1], side="right")
+        segments = position * n_bands + bands
+        order = np.lexsort((data[:, 0], segments))
+        self.x = np.ascontiguousarray(data[order, 0])
+        self.y = np.ascontiguousarray(data[order, 1])
+        self.sample_of = sets.sample_index()[order].astype(np.int32)
+        self.segment_ptr = np.searchsorted(
+            segments[order], np.arange(estimator.n_types_ * n_bands + 1)
+        ).astype(np.intp)
+
+    def _index_columns(self, X):
+        """A feature matrix: one segment per column, its values sorted (no per-object type,
+        band or sort key arrays)."""
+        n_samples, n_features = X.shape
+        order = np.argsort(X, axis=0, kind="stable")
+        self.x = np.take_along_axis(X, order, axis=0).T.ravel()
+        self.sample_of = order.T.astype(np.int32).ravel()
+        del order
+        self.y = np.zeros(len(self.x), dtype=np.float32)
+        self.band_edges = np.array([-np.inf, np.inf])
+        self.segment_ptr = np.arange(n_features + 1, dtype=np.intp) * n_samples
+
+
+def _sampling_region(estimator, data):
+    """Region ``(xmin, xmax, ymin, ymax)`` in which tests of each type are drawn."""
+    if estimator.view_bounds is not None:
+        region = check_view_bounds(estimator.view_bounds)
+    elif len(data):
+        region = np.array([data[:, 0].min(), data[:, 0].max(), data[:, 1].min(), data[:, 1].max()])
+    else:
+        region = np.array([0.0, 1.0, 0.0, 1.0])
+    bounds = np.tile(region, (estimator.n_types_, 1))
+    if estimator._fitted_on_features:
+        bounds[:, 2:] = [-np.inf, np.inf]
+    return np.ascontiguousarray(bounds, dtype=np.float32)
+
+
+def _band_edges(estimator):
+    """Edges of the y bands that index the training objects (an internal speed-up).
+
+    Bands about twice as tall as a fixed or bounded box (measured best) let a test skip most
+    objects of its type; wholly covered bands need no y comparison.
+    """
+    bounds = estimator.bounds_
+    if estimator.test_type in ("fixed", "bounded"):
+        height = float(bounds[0, 3]) - float(bounds[0, 2])
+        n_bands = int(np.clip(np.ceil(height / (4 * estimator.test_width)), 1, _MAX_BANDS))
+    else:
+        n_bands = _DEFAULT_BANDS
+    y0, y1 = float(bounds[0, 2]), float(bounds[0, 3])
+    inner = y0 + (y1 - y0) * np.arange(1, n_bands) / n_bands
+    return np.concatenate([[-np.inf], inner, [np.inf]])
