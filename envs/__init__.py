@@ -9,7 +9,9 @@ Importing this package registers
 
 Every rule constant is a keyword argument (see `WorldRules`), e.g.
 ``gymnasium.make("ObjectWorldTreasure-v0", view="arrow", enemy_speed=0)``;
-``gymnasium.make_vec(id, num_envs=400)`` builds a `BatchedObjectWorld`.
+``gymnasium.make_vec(id, num_envs=400)`` builds a `BatchedObjectWorld`. The envs truncate
+their episodes themselves after ``max_steps`` steps, so the ids register no
+``max_episode_steps`` (gymnasium adds no `TimeLimit`); the spec of a made env reports it.
 """
 from gymnasium.envs.registration import register
 

@@ -1,9 +1,16 @@
 """The vectorised ObjectWorld engine: the game's rules, written once for many worlds.
 
 `ObjectWorldEnv` is this engine over one world and `BatchedObjectWorld` over many, so the
-two cannot disagree. All worlds advance in lockstep. Each world is drawn at reset from its own
-generator, including the move noise of the whole episode, so `step` makes no random calls
-and the transitions of a world never depend on how many worlds run beside it.
+two cannot disagree. All worlds advance in lockstep. Each world draws from its own generator
+only, so the transitions of a world never depend on how many worlds run beside it.
+
+Stream. A world's generator gives, at reset, one block of uniforms: the layout, then the move
+noise of the whole episode (two per step); then the redraws of objects too close to the start,
+and after them the next episode. The noise is read in chunks of `_NOISE_CHUNK` steps: reset
+draws the first chunk with the layout, keeps the generator state where the second one starts
+and skips the stream past the episode's noise; a later chunk is drawn from that kept state.
+The draws are those of taking the whole block at once, in memory that does not grow with
+``max_steps``.
 
 Layout. Objects that never move (money, walls, grass, treasure coins, border walls) are
 "static": ``n_static`` per world, in flat arrays sorted by world and then by cell of a coarse
@@ -22,6 +29,8 @@ from ._rules import (
 
 _GRID_CELL = 4.0  # side of the cells that index static objects (a speed knob, not a rule)
 _ARROW_DISTANCE = 0.9  # the arrow sits at this fraction of view_size from the agent
+_NOISE_CHUNK = 256  # steps of move noise held at a time (a memory knob, not a rule)
+_SKIP_BLOCK = 1 << 16  # uniforms per draw when a stream is skipped by drawing
 
 
 def _border_walls(size_w):
@@ -36,11 +45,31 @@ def _border_walls(size_w):
     ])
 
 
-def _uniforms_per_world(rules):
-    """Number of uniform draws that lay out one world (see `_Engine.reset`)."""
+def _layout_uniforms(rules):
+    """Number of uniforms that lay out one world, before its move noise (see `_Engine.reset`)."""
     n_objects = rules.n_money + rules.n_walls + rules.n_grass + rules.n_enemies
     n_treasure = 2 + 2 * rules.n_treasure if rules.treasure else 0
-    return 2 * n_objects + n_treasure + 2 * rules.max_steps
+    return 2 * n_objects + n_treasure
+
+
+def _skip_uniforms(rng, n):
+    """Advance `rng` past `n` uniforms exactly as ``rng.random(n)`` would, without holding them.
+
+    A PCG64 (or PCG64DXSM) stream spends one step on each uniform, so it jumps with
+    ``advance``; that also drops the 32-bit half a 32-bit integer draw may have buffered,
+    which ``random`` keeps, so the half is restored. Other bit generators draw and discard
+    the uniforms in blocks of `_SKIP_BLOCK`.
+    """
+    bit_generator = rng.bit_generator
+    if isinstance(bit_generator, (np.random.PCG64, np.random.PCG64DXSM)):
+        before = bit_generator.state
+        bit_generator.advance(n)
+        after = bit_generator.state
+        after["has_uint32"], after["uinteger"] = before["has_uint32"], before["uinteger"]
+        bit_generator.state = after
+    else:
+        for start in range(0, n, _SKIP_BLOCK):
+            rng.random(min(_SKIP_BLOCK, n - start))
 
 
 def _check_layout(objects, rules):
@@ -142,8 +171,10 @@ class _Engine:
         """Draw every world afresh, world ``i`` from ``rngs[i]``.
 
         Each world takes one block of uniforms (object positions, treasure, the episode's
-        move noise), then redraws the objects that fell within `start_clearance` of the
-        centre (rejection keeps the density uniform outside it).
+        move noise, of which only the first `_NOISE_CHUNK` steps are drawn now; see the
+        module's docstring), then redraws the objects that fell within `start_clearance` of
+        the centre (rejection keeps the density uniform outside it). The generators are kept
+        for the later chunks of noise.
 
         Parameters
         ----------
@@ -155,8 +186,15 @@ class _Engine:
         """
         rules, n = self.rules, self.n_worlds
         size_w = rules.size_w
-        n_uniforms = _uniforms_per_world(rules)
-        u = np.stack([rng.random(n_uniforms) for rng in rngs])
+        first = min(rules.max_steps, _NOISE_CHUNK)
+        u = np.stack([rng.random(_layout_uniforms(rules) + 2 * first) for rng in rngs])
+        rest = 2 * (rules.max_steps - first)
+        self._noise_states = None
+        if rest:
+            self._noise_states = [rng.bit_generator.state for rng in rngs]
+            for rng in rngs:
+                _skip_uniforms(rng, rest)
+        self._rngs = rngs
         n_objects = self._n_random + rules.n_enemies
         used = 2 * n_objects
         if layout is None:
@@ -191,7 +229,8 @@ class _Engine:
             coins = self._treasure[:, None] + np.stack(
                 [radius * np.cos(angle), radius * np.sin(angle)], axis=2)
             used += 2 + 2 * rules.n_treasure
-        self._noise = rules.move_noise * (2 * u[:, used:].reshape(n, rules.max_steps, 2) - 1)
+        self._noise = rules.move_noise * (2 * u[:, used:].reshape(n, first, 2) - 1)
+        self._noise_start = 0  # the step of self._noise[:, 0]
 
         self._ex = enemies[..., 0].copy()
         self._ey = enemies[..., 1].copy()
@@ -246,9 +285,12 @@ class _Engine:
         """
         rules, n = self.rules, self.n_worlds
         radius = rules.contact_radius
+        if self.t == self._noise_start + self._noise.shape[1]:
+            self._draw_noise()
         moves = actions < 4
         direction = _DIRECTIONS[actions & 3]
-        delta = np.where(moves[:, None], direction + self._noise[:, self.t], 0.0)
+        noise = self._noise[:, self.t - self._noise_start]
+        delta = np.where(moves[:, None], direction + noise, 0.0)
         dx, dy = delta[:, 0], delta[:, 1]
         ax, ay = self.agent[:, 0], self.agent[:, 1]
 
@@ -307,6 +349,25 @@ class _Engine:
         return rewards, self.t >= rules.max_steps
 
     # ----------------------------------------------------------------------------------
+    def _draw_noise(self):
+        """Draw the move noise of the next `_NOISE_CHUNK` steps where each stream keeps it.
+
+        Each generator is set to the kept state, draws, and is put back where it was, so its
+        own position (the next episode's start) does not move.
+        """
+        rules = self.rules
+        count = min(_NOISE_CHUNK, rules.max_steps - self.t)
+        u = np.empty((self.n_worlds, 2 * count))
+        for i, rng in enumerate(self._rngs):
+            bit_generator = rng.bit_generator
+            position = bit_generator.state
+            bit_generator.state = self._noise_states[i]
+            u[i] = rng.random(2 * count)
+            self._noise_states[i] = bit_generator.state
+            bit_generator.state = position
+        self._noise = rules.move_noise * (2 * u.reshape(self.n_worlds, count, 2) - 1)
+        self._noise_start = self.t
+
     def _swipe(self, swiping, direction, erx, ery):
         """Rewards of the swipes; a swipe that hits exactly one enemy kills it."""
         size = self.rules.swipe_size

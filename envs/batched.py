@@ -9,7 +9,10 @@ from gymnasium.vector.utils import batch_space
 
 from ._engine import _Engine
 from ._rules import WorldRules
-from .object_world import _layout_from_options, _object_space
+from .object_world import (
+    _RENDER_MODES, _can_render, _check_render, _layout_from_options, _object_space,
+    _OwnEpisodeLimit, _render_frame,
+)
 
 __all__ = ["BatchedObjectWorld", "RaggedBatch"]
 
@@ -40,14 +43,10 @@ class RaggedBatch:
 
     def __init__(self, data, offsets):
         data = np.ascontiguousarray(data, dtype=np.float32)
-        offsets = np.asarray(offsets, dtype=np.intp)
         if data.ndim != 2 or data.shape[1] != 3:
             raise ValueError(f"data must have shape (N, 3), got {data.shape}")
-        if (offsets.ndim != 1 or len(offsets) == 0 or offsets[0] != 0
-                or offsets[-1] != len(data) or (np.diff(offsets) < 0).any()):
-            raise ValueError("offsets must be non-decreasing from 0 to len(data)")
         self.data = data
-        self.offsets = offsets
+        self.offsets = _check_offsets(offsets, len(data))
 
     def __len__(self):
         return len(self.offsets) - 1
@@ -73,6 +72,25 @@ class RaggedBatch:
         return f"RaggedBatch(n_worlds={len(self)}, n_objects={len(self.data)})"
 
 
+def _check_offsets(offsets, n_rows):
+    """Offsets of a ragged batch of `n_rows` rows, as intp, checked."""
+    offsets = np.asarray(offsets, dtype=np.intp)
+    if (offsets.ndim != 1 or len(offsets) == 0 or offsets[0] != 0
+            or offsets[-1] != n_rows or (np.diff(offsets) < 0).any()):
+        raise ValueError("offsets must be non-decreasing from 0 to len(data)")
+    return offsets
+
+
+class _RaggedBatchSpace(spaces.Tuple):
+    """gymnasium's batch of a `Sequence` space, one per world, that holds `RaggedBatch` too.
+
+    A `RaggedBatch` is checked as the tuple of its worlds ``obs[i]``.
+    """
+
+    def contains(self, x):
+        return super().contains(tuple(x) if isinstance(x, RaggedBatch) else x)
+
+
 def _world_seeds(seed, n):
     """Per-world seeds from `seed`: an int (world i gets seed + i) or n ints."""
     if isinstance(seed, Integral) and not isinstance(seed, bool):
@@ -91,25 +109,36 @@ def _world_seeds(seed, n):
     return [int(s) for s in seeds]
 
 
-def _make_vec(num_envs, **rules):
-    """Vector entry point of the registered ids: ``gymnasium.make_vec(id, num_envs)``."""
-    return BatchedObjectWorld(num_envs, **rules)
+def _make_vec(num_envs, max_episode_steps=None, **kwargs):
+    """Vector entry point of the registered ids: ``gymnasium.make_vec(id, num_envs)``.
+
+    gymnasium passes ``max_episode_steps`` to a vector entry point (it does when remaking the
+    env from its spec); it is the `max_steps` rule, which the batched env applies itself.
+    """
+    if max_episode_steps is not None:
+        max_steps = kwargs.setdefault("max_steps", max_episode_steps)
+        if max_steps != max_episode_steps:
+            raise ValueError(f"max_episode_steps={max_episode_steps!r} and max_steps="
+                             f"{max_steps!r} disagree; both are the episode limit")
+    return BatchedObjectWorld(num_envs, **kwargs)
 
 
-class BatchedObjectWorld(VectorEnv):
+class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
     """`n_worlds` ObjectWorlds stepped together by one vectorised numpy engine.
 
     World ``i`` reset with seed ``s`` and given the same actions goes through exactly the
     transitions of ``ObjectWorldEnv(**rules)`` reset with ``seed=s``: both run the same
-    engine, and every world draws its layout and the move noise of the whole episode from
-    its own generator at reset.
+    engine, and every world draws its layout and its move noise from its own generator only.
 
     Parameters
     ----------
     n_worlds : int
         Number of worlds (``num_envs``).
+    render_mode : {None, "rgb_array"}, default=None
+    render_view : {"world", "local"}, default="world"
+        What `render` draws for each world, as in `ObjectWorldEnv`.
     **rules
-        The keyword arguments of `ObjectWorldEnv` (see `WorldRules`).
+        The rule constants of `ObjectWorldEnv` (see `WorldRules`).
 
     Attributes
     ----------
@@ -119,17 +148,26 @@ class BatchedObjectWorld(VectorEnv):
     view_size : float
     single_observation_space : gymnasium.spaces.Sequence
         The space of ``obs[i]``.
+    observation_space : gymnasium.spaces.Tuple
+        gymnasium's batch of `single_observation_space`, one per world; it holds the
+        `RaggedBatch` observations (and the tuples of per-world arrays).
     single_action_space : gymnasium.spaces.Discrete
+    np_random_seed : int or tuple of int
+        The seed of the last seeded reset: the int ``s`` (world ``i`` got ``s + i``), as
+        gymnasium's vector envs record it, or the tuple of world seeds given. ``np_random``
+        is seeded with it; the worlds draw from generators of their own.
 
     Notes
     -----
     Observations are a `RaggedBatch` (``obs.data``, ``obs.offsets``; ``obs[i]`` is world
-    ``i``'s ``(n_i, 3)`` array; ``tuple(obs)`` lies in `observation_space`). Rewards are
+    ``i``'s ``(n_i, 3)`` array; ``obs`` lies in `observation_space`). Rewards are
     float64 of shape ``(num_envs,)``; episodes never terminate and all worlds are truncated
-    together after `max_steps` steps; that step returns the true final observations.
+    together after `max_steps` steps, by the env itself (``spec.max_episode_steps`` reports
+    it); that step returns the true final observations.
     Autoreset follows gymnasium's next-step mode: the step after a truncation resets every
     world (continuing its generator), ignores the actions and returns zero rewards; calling
-    `reset` explicitly instead is equivalent.
+    `reset` explicitly instead is equivalent. `render` returns a tuple of one frame per world,
+    as gymnasium's vector envs do (drawing every world: render few of them).
 
     Examples
     --------
@@ -142,17 +180,22 @@ class BatchedObjectWorld(VectorEnv):
     (400, (400,))
     """
 
-    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP}
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": _RENDER_MODES,
+                "render_fps": 8}
 
-    def __init__(self, n_worlds, **rules):
+    def __init__(self, n_worlds, render_mode=None, render_view="world", **rules):
         if not isinstance(n_worlds, Integral) or isinstance(n_worlds, bool) or n_worlds < 1:
             raise ValueError(f"n_worlds must be a positive int, got {n_worlds!r}")
         self.rules = WorldRules(**rules)
+        _check_render(render_mode, render_view)
+        self.render_mode = render_mode
+        self.render_view = render_view
         self.num_envs = int(n_worlds)
         self.single_action_space = spaces.Discrete(self.rules.n_actions)
         self.action_space = spaces.MultiDiscrete(np.full(self.num_envs, self.rules.n_actions))
         self.single_observation_space = _object_space(self.rules)
-        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.observation_space = _RaggedBatchSpace(
+            batch_space(self.single_observation_space, self.num_envs).spaces)
         self._engine = _Engine(self.rules, self.num_envs)
         self._rngs = None
         self._autoreset = False
@@ -172,7 +215,8 @@ class BatchedObjectWorld(VectorEnv):
         ----------
         seed : None, int or sequence of int, default=None
             An int ``s`` seeds world ``i`` with ``s + i``; a sequence gives one seed per
-            world. None continues each world's generator (fresh entropy the first time).
+            world. None continues each world's generator; the first time it draws an int
+            from fresh entropy and uses it as ``seed`` (so `np_random_seed` reproduces it).
         options : dict, optional
             ``{"objects": rows}`` places the same objects in every world instead of the
             random ones, as in `ObjectWorldEnv.reset`.
@@ -183,10 +227,13 @@ class BatchedObjectWorld(VectorEnv):
         info : dict
         """
         layout = _layout_from_options(options, self.rules)
+        if seed is None and self._rngs is None:
+            seed = np.random.SeedSequence().entropy
         if seed is not None:
-            self._rngs = [seeding.np_random(s)[0] for s in _world_seeds(seed, self.num_envs)]
-        elif self._rngs is None:
-            self._rngs = [seeding.np_random()[0] for _ in range(self.num_envs)]
+            seeds = _world_seeds(seed, self.num_envs)
+            self._rngs = [seeding.np_random(s)[0] for s in seeds]
+            self._np_random_seed = seeds[0] if isinstance(seed, Integral) else tuple(seeds)
+            self._np_random = np.random.default_rng(self._np_random_seed)
         self._engine.reset(self._rngs, layout)
         self._autoreset = False
         return RaggedBatch(*self._engine.observation), {}
@@ -216,6 +263,17 @@ class BatchedObjectWorld(VectorEnv):
         self._autoreset = truncated
         return (RaggedBatch(*self._engine.observation), rewards, np.zeros(n, dtype=bool),
                 np.full(n, truncated), {})
+
+    def render(self):
+        """One RGB frame per world (see `ObjectWorldEnv.render`), or None without render_mode.
+
+        Returns
+        -------
+        frames : tuple of ndarray of uint8 of shape (side, side, 3)
+        """
+        if not _can_render(self):
+            return None
+        return tuple(_render_frame(self, i) for i in range(self.num_envs))
 
     def _check_actions(self, actions):
         array = np.asarray(actions)

@@ -1,4 +1,6 @@
 """The ObjectWorld game as a gymnasium environment (one world)."""
+import copy
+
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
@@ -9,6 +11,7 @@ from ._rules import WorldRules
 
 __all__ = ["ObjectWorldEnv"]
 
+_RENDER_MODES = ["rgb_array"]
 _RENDER_VIEWS = ("world", "local")
 
 
@@ -31,6 +34,60 @@ def _layout_from_options(options, rules):
     return _check_layout(options["objects"], rules) if "objects" in options else None
 
 
+def _check_render(render_mode, render_view):
+    """Validate the rendering arguments of `ObjectWorldEnv` and `BatchedObjectWorld`."""
+    if render_mode is not None and render_mode not in _RENDER_MODES:
+        raise ValueError(f"unknown render_mode {render_mode!r}; expected None or one of "
+                         f"{_RENDER_MODES}")
+    if render_view not in _RENDER_VIEWS:
+        raise ValueError(f"unknown render_view {render_view!r}; expected one of "
+                         f"{_RENDER_VIEWS}")
+
+
+def _can_render(env):
+    """Whether `env` renders: False (with a warning) without render_mode; an error before reset."""
+    if env.render_mode is None:
+        gym.logger.warn("render() called without render_mode; pass render_mode='rgb_array'")
+        return False
+    if env._engine.observation is None:
+        raise RuntimeError("call reset() before render()")
+    return True
+
+
+def _render_frame(env, i):
+    """The frame of world `i` of `env`'s engine (see `ObjectWorldEnv.render`)."""
+    engine = env._engine
+    if env.render_view == "local":
+        data, offsets = engine.observation
+        return render_local(data[offsets[i]:offsets[i + 1]], env.rules)
+    return render_world(engine.world_objects(i), engine.agent[i], env.rules)
+
+
+class _OwnEpisodeLimit:
+    """Gives an env's `spec` the env's own episode limit, ``max_episode_steps = max_steps``.
+
+    The env truncates its episodes itself, after ``rules.max_steps`` steps. The registered ids
+    therefore have no ``max_episode_steps`` of their own: ``gymnasium.make`` would add a
+    `TimeLimit` at that number, which knows nothing of a ``max_steps`` passed to ``make``
+    and would cut longer episodes short. Instead the spec that gymnasium sets on the env
+    (``make``, ``make_vec``) reports the env's limit, so gymnasium's tools see it.
+    """
+
+    _spec = None
+
+    @property
+    def spec(self):
+        """The `EnvSpec` the env was made from (None if built directly), with its limit."""
+        return self._spec
+
+    @spec.setter
+    def spec(self, spec):
+        if spec is not None:
+            spec = copy.copy(spec)
+            spec.max_episode_steps = self.rules.max_steps
+        self._spec = spec
+
+
 def _check_action(action, n_actions):
     """Return `action` as an int after checking it is a valid action id."""
     if (isinstance(action, (bool, np.bool_))
@@ -41,7 +98,7 @@ def _check_action(action, n_actions):
     return int(action)
 
 
-class ObjectWorldEnv(gym.Env):
+class ObjectWorldEnv(_OwnEpisodeLimit, gym.Env):
     """The ObjectWorld game of Blank (2015): collect money, avoid enemies, don't hit walls.
 
     The world is the square ``[-size_w, size_w]^2`` with a wall-lined border, filled at reset
@@ -83,8 +140,12 @@ class ObjectWorldEnv(gym.Env):
     ``Sequence(Box(3,), stack=True)``. Actions: ``Discrete(4)``, ``0`` up, ``1`` right,
     ``2`` down, ``3`` left; ``Discrete(8)`` with the sword, ``4..7`` swiping in the same
     directions. Reward: the sum of the step's contacts and swipe. Episodes never terminate;
-    they are truncated after `max_steps` steps. Each reset draws a new world from
-    ``self.np_random``.
+    they are truncated after `max_steps` steps, by the env itself: the registered ids add no
+    gymnasium `TimeLimit`, and ``env.spec.max_episode_steps`` reports `max_steps` (the
+    `TimeLimit` that ``gymnasium.make(env.spec)`` adds at that limit truncates on the same
+    step; one from ``gymnasium.make(id, max_episode_steps=k)`` can only cut episodes short,
+    so set their length with `max_steps`). Each reset draws a new world from
+    ``self.np_random``; ``reset(seed=s)`` sets ``np_random_seed`` to ``s``.
 
     Examples
     --------
@@ -97,16 +158,11 @@ class ObjectWorldEnv(gym.Env):
     >>> obs, reward, terminated, truncated, info = env.step(1)
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 8}
+    metadata = {"render_modes": _RENDER_MODES, "render_fps": 8}
 
     def __init__(self, render_mode=None, render_view="world", **rules):
         self.rules = WorldRules(**rules)
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"unknown render_mode {render_mode!r}; expected None or "
-                             f"one of {self.metadata['render_modes']}")
-        if render_view not in _RENDER_VIEWS:
-            raise ValueError(f"unknown render_view {render_view!r}; expected one of "
-                             f"{_RENDER_VIEWS}")
+        _check_render(render_mode, render_view)
         self.render_mode = render_mode
         self.render_view = render_view
         self.action_space = spaces.Discrete(self.rules.n_actions)
@@ -156,11 +212,4 @@ class ObjectWorldEnv(gym.Env):
 
     def render(self):
         """An RGB frame (uint8, ``(side, side, 3)``) of the world or of the local view."""
-        if self.render_mode is None:
-            gym.logger.warn("render() called without render_mode; pass render_mode='rgb_array'")
-            return None
-        if self._engine.observation is None:
-            raise RuntimeError("call reset() before render()")
-        if self.render_view == "local":
-            return render_local(self._engine.observation[0], self.rules)
-        return render_world(self._engine.world_objects(0), self._engine.agent[0], self.rules)
+        return _render_frame(self, 0) if _can_render(self) else None

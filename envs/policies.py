@@ -2,12 +2,38 @@
 import numpy as np
 
 from ._rules import _DIRECTIONS, ENEMY, MONEY, WALL
+from .batched import _check_offsets
 
 __all__ = ["GreedyPolicy"]
 
 _MONEY_PULL = 100.0
 _ENEMY_PUSH = 300.0
 _SOFTENING = 0.5  # keeps the inverse-square pulls finite next to an object
+
+
+def _check_rows(rows, n_types, name):
+    """`rows` as an array of objects ``[dx, dy, type]``, checked as observations of the game.
+
+    Raises a TypeError unless they are numbers, and a ValueError unless they have shape
+    ``(n, 3)``, are finite and hold type ids in ``range(n_types)``.
+    """
+    expected = f"{name} must be an (n, 3) array of objects [dx, dy, type]"
+    try:
+        array = np.asarray(rows)
+    except ValueError:
+        raise ValueError(f"{expected}, got a ragged sequence") from None
+    if array.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must hold numbers, got dtype {array.dtype}")
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise ValueError(f"{expected} (a RaggedBatch for several worlds), got shape "
+                         f"{array.shape}")
+    if not np.isfinite(array).all():
+        raise ValueError(f"{name} contains NaN or infinite values")
+    known = np.isin(array[:, 2], np.arange(n_types))
+    if not known.all():
+        raise ValueError(f"{name} has type id {array[~known, 2][0]}; the types of this game "
+                         f"are the ints 0 to {n_types - 1}")
+    return array
 
 
 class GreedyPolicy:
@@ -44,7 +70,7 @@ class GreedyPolicy:
 
         Parameters
         ----------
-        observation : ndarray of shape (n, 3), or RaggedBatch
+        observation : array-like of shape (n, 3), or RaggedBatch
             One world's objects, or a batch with ``data`` and ``offsets``.
         state, episode_start, deterministic
             Unused (the policy is stateless and deterministic).
@@ -53,11 +79,20 @@ class GreedyPolicy:
         -------
         actions : int or ndarray of int of shape (n_worlds,)
         state : None
+
+        Raises
+        ------
+        TypeError
+            If the observation does not hold numbers.
+        ValueError
+            If it is not of shape ``(n, 3)`` (``data`` of a batch likewise, with valid
+            ``offsets``), holds NaN or infinite values, or type ids not of this game.
         """
+        n_types = self.rules.n_types
         if hasattr(observation, "data") and hasattr(observation, "offsets"):
-            actions = self._actions(np.asarray(observation.data), np.asarray(observation.offsets))
-            return actions, None
-        rows = np.asarray(observation, dtype=np.float32).reshape(-1, 3)
+            rows = _check_rows(observation.data, n_types, "observation.data")
+            return self._actions(rows, _check_offsets(observation.offsets, len(rows))), None
+        rows = _check_rows(observation, n_types, "observation")
         return self._actions(rows, np.array([0, len(rows)]))[0], None
 
     def _actions(self, rows, offsets):

@@ -8,13 +8,15 @@ from gymnasium import spaces
 __all__ = ["PaddedObjects", "strip_padding"]
 
 
-class PaddedObjects(gym.ObservationWrapper):
+class PaddedObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     """Pad the object set to a fixed ``(max_objects, 4)`` `Box` (e.g. for stable-baselines3).
 
     Row ``j`` is ``[dx, dy, type, valid]``: the first ``n`` rows hold the observed objects
     with ``valid = 1``, the remaining rows are zeros (``valid = 0``). `strip_padding` turns
     padded observations back into object sets. When more than `max_objects` objects are in
-    view, the `max_objects` nearest to the agent are kept (in their original order).
+    view, the `max_objects` nearest to the agent are kept (in their original order). The
+    wrapper records `max_objects` in the env's spec, so ``gymnasium.make(env.spec)`` rebuilds
+    it.
 
     Parameters
     ----------
@@ -35,7 +37,8 @@ class PaddedObjects(gym.ObservationWrapper):
     """
 
     def __init__(self, env, max_objects):
-        super().__init__(env)
+        gym.utils.RecordConstructorArgs.__init__(self, max_objects=max_objects)
+        gym.ObservationWrapper.__init__(self, env)
         space = env.observation_space
         if not (isinstance(space, spaces.Sequence) and space.stack
                 and isinstance(space.feature_space, spaces.Box)

@@ -1,5 +1,8 @@
 """The ObjectWorld rules, the gymnasium API, rendering, wrappers and bad input."""
+import copy
 import doctest
+import hashlib
+import tracemalloc
 
 import gymnasium as gym
 import numpy as np
@@ -70,6 +73,35 @@ def test_world_seeds_reproduce_and_differ():
     assert not np.array_equal(a.reset(seed=7)[0], b.reset(seed=8)[0])
     actions = [1, 1, 0, 3, 2, 2, 1]
     assert [a.step(x)[1:4] for x in actions] == [b.step(x)[1:4] for x in actions]
+
+
+def test_np_random_seed_is_the_reset_seed():
+    env = gym.make("ObjectWorld-v0")
+    env.reset(seed=5)
+    assert env.np_random_seed == 5 == env.unwrapped.np_random_seed
+    env.reset()
+    assert env.np_random_seed == 5  # continuing the generator keeps the seed
+    worlds = gym.make_vec("ObjectWorld-v0", num_envs=3)
+    worlds.reset(seed=5)
+    assert worlds.np_random_seed == 5  # world i has seed 5 + i, as in gymnasium's vector envs
+
+
+def test_spec_carries_the_episode_limit_without_a_time_limit_wrapper():
+    env = gym.make("ObjectWorld-v0")
+    assert env.spec.max_episode_steps == 50 == env.unwrapped.spec.max_episode_steps
+    longer = gym.make("ObjectWorldSword-v0", max_steps=70)
+    assert longer.spec.max_episode_steps == 70
+    wrapper = longer
+    while wrapper is not wrapper.unwrapped:
+        assert not isinstance(wrapper, gym.wrappers.TimeLimit)
+        wrapper = wrapper.env
+    remade = gym.make(longer.spec)  # adds a TimeLimit at the env's own limit
+    assert remade.spec.max_episode_steps == 70 and remade.unwrapped.rules.max_steps == 70
+    for env in (longer, remade):
+        env.reset(seed=2)
+        truncations = [env.step(t % 8)[3] for t in range(70)]
+        assert truncations == [False] * 69 + [True]
+    assert envs.ObjectWorldEnv().spec is None
 
 
 def test_reference_worlds_are_fixed_and_disjoint_from_training_seeds():
@@ -255,6 +287,101 @@ def test_arrow_points_at_the_treasure():
         assert cosine > 0.998
 
 
+def _legs(t):
+    """Ten steps up, ten right, ten down, ten left, and again."""
+    return (t // 10) % 4
+
+
+def _legs_and_swipes(t):
+    return 4 + t % 4 if t % 5 == 0 else _legs(t)
+
+
+def _east_then_legs(t):
+    return RIGHT if t < 30 else _legs(t)
+
+
+# Transitions as the code behind the committed results played them: a digest of every
+# observation and reward (and of the next reset's observation), and each episode's total
+# reward. Any change to a world's generator stream (layout, move noise, clearance redraws,
+# where the next episode starts) changes them. Seed 4 redraws objects near the start; 600
+# steps span several chunks of noise.
+PINNED = [
+    ({}, 3, 2, _legs, "dfbe9133527b1918", [-900.0, -600.0]),
+    ({}, 4, 2, _legs, "ffa2ff35db16d2f5", [-800.0, -500.0]),
+    ({"sword": True}, 9, 1, _legs_and_swipes, "a1e28a2216949774", [-7650.0]),
+    ({"treasure": True}, 5, 2, _east_then_legs, "b4bfe12e37ffff27", [-50.0, -50.0]),
+    ({"max_steps": 600}, 3, 1, _legs, "f5ea5ce39ae92e7b", [-800.0]),
+]
+
+
+@pytest.mark.parametrize("rules, seed, n_episodes, policy, digest, totals", PINNED)
+def test_transitions_are_pinned(rules, seed, n_episodes, policy, digest, totals):
+    env = envs.ObjectWorldEnv(**rules)
+    played = hashlib.sha256()
+    episode_totals = []
+    obs, _ = env.reset(seed=seed)
+    for _ in range(n_episodes):
+        played.update(obs.tobytes())
+        total = 0.0
+        for t in range(env.rules.max_steps):
+            obs, reward, _, truncated, _ = env.step(policy(t))
+            played.update(obs.tobytes() + np.float64(reward).tobytes())
+            total += reward
+        assert truncated
+        episode_totals.append(total)
+        obs, _ = env.reset()
+    played.update(obs.tobytes())
+    assert (played.hexdigest()[:16], episode_totals) == (digest, totals)
+
+
+@pytest.mark.parametrize("bit_generator", [np.random.PCG64, np.random.MT19937])
+def test_move_noise_is_the_stream_after_the_layout_episode_after_episode(monkeypatch,
+                                                                         bit_generator):
+    # Small chunks, so that an episode spans several; MT19937 cannot jump and skips by drawing.
+    monkeypatch.setattr(envs._engine, "_NOISE_CHUNK", 7)
+    env = envs.ObjectWorldEnv(n_money=0, n_walls=0, n_grass=0, n_enemies=0, max_steps=30)
+    env.np_random = np.random.Generator(bit_generator(7))
+    stream = copy.deepcopy(env.np_random)  # no layout draws: the noise comes first
+    noise = []
+    for _ in range(2):
+        obs, _ = env.reset(options={"objects": [[0, 3, GRASS]]})
+        for t in range(30):
+            new, *_ = env.step(RIGHT if t % 2 else LEFT)
+            noise.append(of_type(obs, GRASS)[0] - of_type(new, GRASS)[0] - [1 if t % 2 else -1, 0])
+            obs = new
+    np.testing.assert_allclose(noise, 0.1 * (2 * stream.random((60, 2)) - 1), atol=1e-5)
+
+
+@pytest.mark.parametrize("bit_generator", [np.random.PCG64, np.random.PCG64DXSM,
+                                           np.random.MT19937, np.random.Philox])
+def test_skipping_uniforms_leaves_the_generator_as_drawing_them_would(bit_generator):
+    rng = np.random.Generator(bit_generator(3))
+    rng.integers(10, dtype=np.uint32)  # may buffer half of a 64-bit draw
+    drawn = copy.deepcopy(rng)
+    envs._engine._skip_uniforms(rng, 3 * envs._engine._SKIP_BLOCK + 5)
+    drawn.random(3 * envs._engine._SKIP_BLOCK + 5)
+    for draw in (lambda g: g.integers(2**32, size=3, dtype=np.uint32), lambda g: g.random(3)):
+        np.testing.assert_array_equal(draw(rng), draw(drawn))
+
+
+def _peak_bytes(call):
+    """Peak memory that ``call()`` allocates (numpy's arrays included)."""
+    tracemalloc.start()
+    try:
+        call()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_memory_does_not_grow_with_max_steps():
+    env = envs.ObjectWorldEnv(max_steps=10**6)  # the episode's noise alone would take 16 MB
+    assert _peak_bytes(lambda: env.reset(seed=0)) < 1_000_000
+    for t in range(256):
+        env.step(t % 4)
+    assert _peak_bytes(lambda: env.step(0)) < 1_000_000  # draws the next chunk of noise
+
+
 def test_rng_draws_do_not_depend_on_the_view():
     seen = [envs.ObjectWorldEnv(treasure=True, view=v).reset(seed=2)[0] for v in envs.VIEWS]
     local = seen[0]
@@ -279,11 +406,32 @@ def test_render_draws_objects_agent_and_view(render_view):
     assert not np.array_equal(frame, env.render())
 
 
-def test_render_without_mode_warns_and_returns_none():
-    env = envs.ObjectWorldEnv()
+@pytest.mark.parametrize("render_view", ["world", "local"])
+def test_render_of_a_batch_is_one_frame_per_world(render_view):
+    worlds = gym.make_vec("ObjectWorld-v0", num_envs=2, render_mode="rgb_array",
+                          render_view=render_view)
+    worlds.reset(seed=3)
+    worlds.step(np.array([1, 2]))
+    frames = worlds.render()
+    assert isinstance(frames, tuple) and len(frames) == 2
+    for i, frame in enumerate(frames):
+        env = envs.ObjectWorldEnv(render_mode="rgb_array", render_view=render_view)
+        env.reset(seed=3 + i)
+        env.step([1, 2][i])
+        np.testing.assert_array_equal(frame, env.render())
+    assert not np.array_equal(frames[0], frames[1])
+
+
+@pytest.mark.parametrize("make", [envs.ObjectWorldEnv,
+                                  lambda **kwargs: envs.BatchedObjectWorld(2, **kwargs)],
+                         ids=["single", "batched"])
+def test_render_without_mode_warns_and_before_reset_raises(make):
+    env = make()
     env.reset(seed=0)
     with pytest.warns(UserWarning, match="render_mode"):
         assert env.render() is None
+    with pytest.raises(RuntimeError, match="reset"):
+        make(render_mode="rgb_array").render()
 
 
 # --------------------------------------------------------------------------- wrappers, policy
@@ -304,6 +452,16 @@ def test_padded_objects_keeps_the_nearest_when_full():
     env = envs.PaddedObjects(envs.ObjectWorldEnv(move_noise=0.0), max_objects=2)
     obs, _ = env.reset(seed=0, options={"objects": [[5, 5, GRASS], [1, 0, GRASS], [0, 2, MONEY]]})
     np.testing.assert_array_equal(envs.strip_padding(obs)[0], [[1, 0, GRASS], [0, 2, MONEY]])
+
+
+@pytest.mark.filterwarnings("ignore:.*different from the unwrapped version")
+def test_padded_objects_is_remade_from_its_spec_and_passes_check_env():
+    env = envs.PaddedObjects(gym.make("ObjectWorldTreasure-v0", view="arrow"), max_objects=24)
+    remade = gym.make(env.spec)
+    assert isinstance(remade, envs.PaddedObjects) and remade.max_objects == 24
+    assert remade.unwrapped.rules == env.unwrapped.rules
+    np.testing.assert_array_equal(remade.reset(seed=4)[0], env.reset(seed=4)[0])
+    check_env(env)
 
 
 def test_greedy_policy_beats_random_play():
@@ -380,6 +538,8 @@ def test_unknown_rule_is_a_type_error():
 def test_bad_render_arguments(kwargs, match):
     with pytest.raises(ValueError, match=match):
         envs.ObjectWorldEnv(**kwargs)
+    with pytest.raises(ValueError, match=match):
+        gym.make_vec("ObjectWorld-v0", num_envs=2, **kwargs)
 
 
 @pytest.mark.parametrize("options, match", [
@@ -393,6 +553,39 @@ def test_bad_render_arguments(kwargs, match):
 def test_bad_reset_options(options, match):
     with pytest.raises(ValueError, match=match):
         envs.ObjectWorldEnv().reset(seed=0, options=options)
+
+
+GOOD_ROWS = [[1.0, 0.0, MONEY], [0.0, 2.0, WALL]]
+
+
+@pytest.mark.parametrize("observation, error, match", [
+    (np.zeros((3, 2)), ValueError, r"\(n, 3\) array .* got shape \(3, 2\)"),
+    (np.zeros(6), ValueError, r"got shape \(6,\)"),
+    (np.zeros((2, 4, 3)), ValueError, r"RaggedBatch for several worlds\), got shape \(2, 4, 3\)"),
+    ([[0.0, 1.0, MONEY], [np.nan, 0.0, WALL]], ValueError, "NaN or infinite"),
+    ([[0.0, np.inf, MONEY]], ValueError, "NaN or infinite"),
+    ([[0.0, 1.0, 9]], ValueError, "type id 9.0; the types of this game are the ints 0 to 3"),
+    ([[0.0, 1.0, 0.5]], ValueError, "type id 0.5"),
+    ([[0.0, 1.0], [2.0, 3.0, 0.0]], ValueError, "ragged sequence"),
+    (np.array([["a", "b", "c"]]), TypeError, "must hold numbers"),
+    (None, TypeError, "must hold numbers"),
+    (envs.RaggedBatch(np.array([[0, 1, MONEY], [np.nan, 0, WALL]]), [0, 1, 2]), ValueError,
+     "observation.data contains NaN"),
+])
+def test_greedy_policy_rejects_bad_observations(observation, error, match):
+    policy = envs.GreedyPolicy(envs.ObjectWorldEnv())
+    assert policy.predict(np.array(GOOD_ROWS))[0] in range(4)
+    assert policy.predict(np.empty((0, 3)))[0] in range(4)
+    with pytest.raises(error, match=match):
+        policy.predict(observation)
+
+
+def test_greedy_policy_rejects_a_batch_with_bad_offsets():
+    class Batch:  # duck-typed, like boxtrees.ObjectSets
+        data = np.array(GOOD_ROWS, dtype=np.float32)
+        offsets = np.array([0, 3])
+    with pytest.raises(ValueError, match="offsets"):
+        envs.GreedyPolicy(envs.ObjectWorldEnv()).predict(Batch())
 
 
 def test_bad_wrapper_input():

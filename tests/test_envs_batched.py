@@ -51,6 +51,27 @@ def test_batched_equals_single_step_by_step(rules):
     assert n_steps == 150
 
 
+@pytest.mark.parametrize("rules", [{}, {"treasure": True, "view": "minimap"}], ids=_variant_id)
+def test_batched_equals_single_across_chunks_of_noise(monkeypatch, rules):
+    monkeypatch.setattr(envs._engine, "_NOISE_CHUNK", 5)  # 23 steps: chunks 5, ..., 5, 3
+    n, seeds = 3, [4, 8, 31]
+    worlds = envs.BatchedObjectWorld(n, max_steps=23, **rules)
+    singles = [envs.ObjectWorldEnv(max_steps=23, **rules) for _ in range(n)]
+    obs, _ = worlds.reset(seed=seeds)
+    expected = [env.reset(seed=s)[0] for env, s in zip(singles, seeds)]
+    actions = np.random.default_rng(1).integers(worlds.rules.n_actions, size=(2, 23, n))
+    for episode in actions:  # the second episode continues the generators
+        for batch in episode:
+            for i in range(n):
+                np.testing.assert_array_equal(obs[i], expected[i])
+            obs, rewards, *_ = worlds.step(batch)
+            for i, env in enumerate(singles):
+                expected[i], reward, *_ = env.step(batch[i])
+                assert rewards[i] == reward
+        obs, _ = worlds.reset()
+        expected = [env.reset()[0] for env in singles]
+
+
 def test_make_vec_builds_the_batched_engine():
     worlds = gym.make_vec("ObjectWorldSword-v0", num_envs=3, n_enemies=5)
     assert isinstance(worlds, envs.BatchedObjectWorld) and worlds.num_envs == 3
@@ -58,6 +79,34 @@ def test_make_vec_builds_the_batched_engine():
     obs, _ = worlds.reset(seed=0)
     np.testing.assert_array_equal(obs[2], gym.make("ObjectWorldSword-v0", n_enemies=5)
                                   .reset(seed=2)[0])
+
+
+def test_make_vec_spec_carries_the_limit_and_remakes_the_env():
+    worlds = gym.make_vec("ObjectWorldSword-v0", num_envs=3, max_steps=7)
+    assert worlds.spec.max_episode_steps == 7 and worlds.spec.kwargs["num_envs"] == 3
+    remade = gym.make_vec(worlds.spec)  # gymnasium passes max_episode_steps=7 to the entry
+    assert isinstance(remade, envs.BatchedObjectWorld) and remade.rules == worlds.rules
+    np.testing.assert_array_equal(remade.reset(seed=1)[0].data, worlds.reset(seed=1)[0].data)
+    assert gym.make_vec("ObjectWorld-v0", num_envs=2).spec.max_episode_steps == 50
+    assert gym.make_vec("ObjectWorld-v0", num_envs=2, max_episode_steps=9).rules.max_steps == 9
+    with pytest.raises(ValueError, match="max_episode_steps=9 and max_steps=8 disagree"):
+        gym.make_vec("ObjectWorld-v0", num_envs=2, max_episode_steps=9, max_steps=8)
+
+
+def test_np_random_seed_follows_gymnasium_vector_envs():
+    worlds = envs.BatchedObjectWorld(3)
+    first, _ = worlds.reset()  # fresh entropy, recorded as the seed
+    seed = worlds.np_random_seed
+    np.testing.assert_array_equal(envs.BatchedObjectWorld(3).reset(seed=seed)[0].data,
+                                  first.data)
+    worlds.reset(seed=5)
+    assert worlds.np_random_seed == 5
+    worlds.reset()
+    assert worlds.np_random_seed == 5  # continuing the generators keeps it
+    worlds.reset(seed=[7, 3, 9])
+    assert worlds.np_random_seed == (7, 3, 9)
+    assert worlds.np_random.random() == np.random.default_rng([7, 3, 9]).random()
+    assert worlds.np_random_seed == (7, 3, 9)
 
 
 def test_int_seed_gives_world_i_seed_plus_i():
@@ -87,6 +136,23 @@ def test_observation_is_a_ragged_batch():
     assert all(worlds.single_observation_space.contains(o) for o in obs)
     with pytest.raises(IndexError):
         obs[5]
+
+
+@pytest.mark.parametrize("rules", [{}, {"treasure": True, "view": "arrow"}], ids=_variant_id)
+def test_observations_lie_in_the_observation_space(rules):
+    worlds = envs.BatchedObjectWorld(4, max_steps=2, **rules)
+    space = worlds.observation_space
+    obs, _ = worlds.reset(seed=0)
+    assert space.contains(obs) and obs in space
+    for _ in range(3):  # the last step autoresets
+        obs = worlds.step(np.array([0, 1, 2, 3]))[0]
+        assert space.contains(obs)
+    assert space.contains(space.sample())
+    assert not space.contains(envs.BatchedObjectWorld(3, **rules).reset(seed=0)[0])
+    far = obs.data.copy()
+    far[0, 0] = 1e3  # beyond the view
+    assert not space.contains(envs.RaggedBatch(far, obs.offsets))
+    assert space == gym.vector.utils.batch_space(worlds.single_observation_space, 4)
 
 
 def test_vector_env_attributes():
