@@ -8,7 +8,9 @@
 Writes under ``--out`` (default ``results/``): one PNG per figure, ``runs/`` (one JSON per
 finished run, reused by later invocations), one CSV of raw numbers per experiment,
 ``summary.json`` and ``REPORT.md``. The experiments are the registry in
-``benchmarks/reproduce/registry.py``.
+``benchmarks/reproduce/registry.py``. Exit status: 2 for an invalid argument, 1 if ``--out``
+cannot be written or a run was skipped after crashing 3 times (the report counts it as
+missing), 130 on Ctrl-C (an interrupt is no crash; finished runs stay cached).
 """
 import sys
 from pathlib import Path

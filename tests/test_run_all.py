@@ -1,5 +1,6 @@
 """benchmarks/run_all.py: registry, runner (end to end at the tiny budget), cache and resume,
 findings and the report writer."""
+import errno
 import json
 from dataclasses import replace
 
@@ -7,6 +8,7 @@ import numpy as np
 import pytest
 
 from benchmarks.reproduce import BUDGETS, EXPERIMENTS, REGISTRY
+from benchmarks.reproduce import runner
 from benchmarks.reproduce.cache import (attempts, load_unit, mark_attempt, save_unit, slug,
                                         unit_path)
 from benchmarks.reproduce.cli import main, parse_seeds
@@ -14,7 +16,7 @@ from benchmarks.reproduce.findings import (Falls, HighestPeak, MoreStable, NearR
                                            Ranking, Sign, Similar)
 from benchmarks.reproduce.registry import Experiment, resolve
 from benchmarks.reproduce.report import figure_name, write_outputs
-from benchmarks.reproduce.runner import MAX_ATTEMPTS, plan, run
+from benchmarks.reproduce.runner import MAX_ATTEMPTS, gather, plan, run
 from benchmarks.reproduce.stats import SettingStats, summarise
 
 TINY = BUDGETS["tiny"]
@@ -93,22 +95,142 @@ def test_parse_seeds():
         parse_seeds("x")
 
 
+_BAD_ARGUMENTS = [
+    (["--seeds", "5-2"], "argument --seeds: '5-2' selects no seed"),
+    (["--seeds", "0"], "argument --seeds: '0' selects no seed"),
+    (["--seeds", ""], "argument --seeds: expected a count (3), a list (0,2,4) or a range"),
+    (["--seeds", "0,0,0"], "argument --seeds: '0,0,0' repeats seed 0"),
+    (["--seeds", "1,-2"], "argument --seeds: '1,-2' selects a seed outside 0 .. 4294967295"),
+    (["--seeds", "1001"], "argument --seeds: '1001' selects 1,001 seeds, more than 1,000"),
+    (["--jobs", "0"], "argument --jobs: expected a whole number of 1 or more, got '0'"),
+    (["--jobs", "-1"], "argument --jobs: expected a whole number of 1 or more, got '-1'"),
+    (["--only", ""], "argument --only: names no experiment; known: rmse_K"),
+]
+
+
+@pytest.mark.parametrize("argv, message", _BAD_ARGUMENTS,
+                         ids=[" ".join(argv) for argv, _ in _BAD_ARGUMENTS])
+def test_bad_arguments_are_rejected_before_any_work(tmp_path, capsys, argv, message):
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as exit_:
+        main([*argv, "--budget", "tiny", "--out", str(out), "--report-only"])
+    assert exit_.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_out_blocked_by_a_file_is_rejected(tmp_path, capsys):
+    blocker = tmp_path / "notes.txt"
+    blocker.write_text("not a folder")
+    for out in (blocker, blocker / "results"):
+        with pytest.raises(SystemExit) as exit_:
+            main(["--budget", "tiny", "--out", str(out), "--report-only"])
+        assert exit_.value.code == 2
+        assert f"argument --out: {blocker} exists and is not a folder" in capsys.readouterr().err
+    assert blocker.read_text() == "not a folder"
+
+
+def test_unwritable_out_is_one_error_line_and_other_errors_still_raise(tmp_path, capsys,
+                                                                     monkeypatch):
+    def denied(path):  # what a read-only folder answers (root may write anywhere)
+        raise PermissionError(errno.EACCES, "Permission denied", str(path.parent))
+
+    monkeypatch.setattr(runner, "mark_attempt", denied)
+    argv = ["--budget", "tiny", "--only", "attention", "--out", str(tmp_path), "--no-progress"]
+    with pytest.raises(SystemExit) as exit_:
+        main(argv)
+    assert exit_.value.code == 1
+    unit, = plan([REGISTRY["attention"]], TINY, tmp_path)
+    assert capsys.readouterr().err.splitlines() == [
+        f"run_all.py: error: cannot write under --out {tmp_path}: Permission denied: "
+        f"{unit.path.parent}"]
+
+    def missing(*args):
+        raise FileNotFoundError(errno.ENOENT, "No such file or directory", "/elsewhere")
+
+    monkeypatch.undo()
+    monkeypatch.setattr(runner, "run_unit", missing)
+    with pytest.raises(FileNotFoundError):  # a unit's own error keeps its traceback
+        main(argv)
+
+
 # ------------------------------------------------------------------------------ cache
 def test_cache_round_trip_and_mismatch(tmp_path):
     params = REGISTRY["fqi_K"].params("K=50")
     path = unit_path(tmp_path, TINY, "fqi_K", "K=50", 0)
     assert path == tmp_path / "runs" / "tiny" / "fqi_K" / "K-50" / "seed0.json"
-    save_unit(path, params, TINY, 200, "fqi_K", "K=50", 0, {"rewards": [1.0], "seconds": 1})
-    assert load_unit(path, params, TINY, 200)["result"]["rewards"] == [1.0]
+    save_unit(path, params, TINY, 200, "fqi_K", "K=50", 0, _FQI_RESULT)
+    assert load_unit(path, params, TINY, 200, 0)["result"]["rewards"] == [1.0, 2.0]
     assert list(path.parent.iterdir()) == [path]  # no temporary file left behind
-    assert load_unit(path, {**params, "n_tests": 51}, TINY, 200) is None  # other params
-    assert load_unit(path, params, TINY, 400) is None  # other samples per iteration
-    assert load_unit(path, params, replace(TINY, iterations=3), 200) is None
-    assert load_unit(path, params, replace(TINY, seeds=4), 200) is not None  # irrelevant
-    assert load_unit(path, params, replace(TINY, name="quick"), 200) is None
+    assert load_unit(path, {**params, "n_tests": 51}, TINY, 200, 0) is None  # other params
+    assert load_unit(path, params, TINY, 400, 0) is None  # other samples per iteration
+    assert load_unit(path, params, replace(TINY, iterations=3), 200, 0) is None
+    assert load_unit(path, params, replace(TINY, seeds=4), 200, 0) is not None  # irrelevant
+    assert load_unit(path, params, replace(TINY, name="quick"), 200, 0) is None
     path.write_text("{truncated")
-    assert load_unit(path, params, TINY, 200) is None
+    assert load_unit(path, params, TINY, 200, 0) is None
     assert slug("mixed (every 5)") == "mixed_every_5"
+
+
+# A finished FQI unit's result at the tiny budget (2 iterations).
+_FQI_RESULT = {"rewards": [1.0, 2.0], "random_reward": -1.0, "seconds": 0.5}
+
+
+def _save_sampling(out, label, seed):
+    path = unit_path(out, TINY, "sampling", label, seed)
+    save_unit(path, REGISTRY["sampling"].params(label, TINY), TINY, TINY.samples, "sampling",
+              label, seed, _FQI_RESULT)
+    return path
+
+
+def _without_seconds(path):
+    record = json.loads(path.read_text())
+    del record["result"]["seconds"]
+    return json.dumps(record)
+
+
+def _short_rewards(path):
+    record = json.loads(path.read_text())
+    record["result"]["rewards"] = [1.0]
+    return json.dumps(record)
+
+
+@pytest.mark.parametrize("damage, problem", [
+    (lambda path: "null", "the record is not a JSON object"),
+    (lambda path: "[1, 2]", "the record is not a JSON object"),
+    (_without_seconds, "no result.seconds"),
+    (_short_rewards, "result.rewards is not a list of 2"),
+    (lambda path: "{truncated", "not readable as JSON"),
+], ids=["null", "list", "no seconds", "short rewards", "truncated"])
+def test_a_cached_file_that_is_no_run_record_counts_as_missing(tmp_path, capsys, monkeypatch,
+                                                               damage, problem):
+    good = _save_sampling(tmp_path, "normal", 0)
+    bad = _save_sampling(tmp_path, "mixed (every 5)", 0)
+    bad.write_text(damage(bad))
+    kept = good.stat().st_mtime_ns
+    argv = ["--budget", "tiny", "--only", "sampling", "--seeds", "1", "--out", str(tmp_path),
+            "--no-progress"]
+    text = main([*argv, "--report-only"]).read_text()
+    assert "| 3.9 | [sampling](#sampling) | 1/2 |" in text  # the good run, not the bad one
+    # once, though keep_data's "mixed" setting reads the same file
+    assert [line for line in capsys.readouterr().err.splitlines() if str(bad) in line] == [
+        f"ignoring {bad}: not a run record ({problem}); it counts as missing"]
+    monkeypatch.setattr(runner, "run_unit", lambda *args: dict(_FQI_RESULT))
+    main(argv)
+    assert load_unit(bad, REGISTRY["sampling"].params("mixed (every 5)", TINY), TINY,
+                     TINY.samples, 0)["result"] == _FQI_RESULT  # run again
+    assert good.stat().st_mtime_ns == kept
+
+
+def test_a_run_is_never_counted_twice(tmp_path, capsys):
+    seed0 = _save_sampling(tmp_path, "normal", 0)
+    stats, _ = gather(REGISTRY["sampling"], TINY, tmp_path, seeds=[0, 0])
+    assert stats["normal"].n_runs == 1
+    seed1 = unit_path(tmp_path, TINY, "sampling", "normal", 1)
+    seed1.write_text(seed0.read_text())  # a copy is not the run of seed 1
+    stats, _ = gather(REGISTRY["sampling"], TINY, tmp_path, seeds=[0, 1])
+    assert stats["normal"].n_runs == 1
+    assert f"ignoring {seed1}: not a run record (it records seed 0)" in capsys.readouterr().err
 
 
 # ------------------------------------------------------------------------------ end to end
@@ -147,10 +269,10 @@ def test_every_experiment_runs_end_to_end(tiny_run):
 def test_second_invocation_reuses_the_cache_and_resumes(tiny_run):
     out, _ = tiny_run
     units = plan([REGISTRY["representations"]], TINY, out)
-    assert run(units, TINY, progress=False) == []  # everything cached
+    assert run(units, TINY, progress=False) == ([], [])  # everything cached
     units[2].path.unlink()
     before = units[0].path.stat().st_mtime_ns
-    rerun = run(units, TINY, progress=False)
+    rerun, _ = run(units, TINY, progress=False)
     assert [u.path for u, _ in rerun] == [units[2].path]
     assert units[2].path.exists() and units[0].path.stat().st_mtime_ns == before
 
@@ -164,9 +286,54 @@ def test_units_that_crashed_run_last_and_are_skipped_after_max_attempts(tiny_run
     for _ in range(MAX_ATTEMPTS):
         mark_attempt(units[1].path)  # crashed too often: skipped
     assert attempts(units[1].path) == MAX_ATTEMPTS
-    rerun = [u.path for u, _ in run(units, TINY, progress=False)]
-    assert rerun == [units[2].path, units[0].path]
+    done, skipped = run(units, TINY, progress=False)
+    assert [u.path for u, _ in done] == [units[2].path, units[0].path]
+    assert skipped == [units[1]]
     assert attempts(units[0].path) == 0 and not units[1].path.exists()
+
+
+def test_a_unit_skipped_after_crashes_fails_the_command(tmp_path, capsys):
+    unit, = plan([REGISTRY["attention"]], TINY, tmp_path)
+    for _ in range(MAX_ATTEMPTS):
+        mark_attempt(unit.path)
+    with pytest.raises(SystemExit) as exit_:
+        main(["--budget", "tiny", "--only", "attention", "--out", str(tmp_path),
+              "--no-progress"])
+    assert exit_.value.code == 1
+    err = capsys.readouterr().err
+    assert f"skipping attention/bounded TW=4/seed0: it crashed {MAX_ATTEMPTS} times" in err
+    assert err.endswith(f"run_all.py: error: 1 run(s) skipped after crashing {MAX_ATTEMPTS} "
+                        f"times (listed above); the report counts them as missing\n")
+    assert "| extra | [attention](#attention) | 0/1 |" in (tmp_path / "REPORT.md").read_text()
+
+
+def _interrupt(*args):
+    raise KeyboardInterrupt
+
+
+def test_interrupts_are_not_counted_as_crashes(tmp_path, monkeypatch):
+    units = plan([REGISTRY["sampling"]], TINY, tmp_path, seeds=[0])
+    mark_attempt(units[0].path)  # one real crash before
+    monkeypatch.setattr(runner, "run_unit", _interrupt)
+    for _ in range(MAX_ATTEMPTS + 1):
+        with pytest.raises(KeyboardInterrupt):
+            run(units, TINY, progress=False)
+    assert [attempts(u.path) for u in units] == [1, 0]
+    monkeypatch.setattr(runner, "run_unit", lambda *args: dict(_FQI_RESULT))
+    done, skipped = run(units, TINY, progress=False)
+    assert [u for u, _ in done] == [units[1], units[0]] and skipped == []
+
+
+def test_an_interrupted_command_says_so_in_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(runner, "run_unit", _interrupt)
+    with pytest.raises(SystemExit) as exit_:
+        main(["--budget", "tiny", "--only", "attention", "--out", str(tmp_path),
+              "--no-progress"])
+    assert exit_.value.code == 130
+    assert capsys.readouterr().err.splitlines() == [
+        "run_all.py: interrupted; finished runs are cached: run the same command to resume"]
+    unit, = plan([REGISTRY["attention"]], TINY, tmp_path)
+    assert attempts(unit.path) == 0
 
 
 def test_report_marks_missing_runs_as_partial(tiny_run, tmp_path):
@@ -263,6 +430,6 @@ def test_budget_overrides_reach_every_setting_of_their_experiment_and_its_cache(
     unit = next(u for u in units if u.experiment == "treasure")
     save_unit(unit.path, REGISTRY["treasure"].params(unit.label), budget, unit.samples,
               "treasure", unit.label, unit.seed, {"rewards": [0.0], "seconds": 1.0})
-    assert load_unit(unit.path, unit.params, budget, unit.samples) is None
+    assert load_unit(unit.path, unit.params, budget, unit.samples, unit.seed) is None
     report = write_outputs([REGISTRY["treasure"]], budget, tmp_path).read_text()
     assert "`treasure` runs with n_estimators=1 (every setting alike)" in report

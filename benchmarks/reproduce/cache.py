@@ -2,17 +2,21 @@
 
 Layout: ``<out>/runs/<budget>/<experiment>/<setting>/seed<k>.json``. A file counts as
 finished only if its recorded parameters and budget equal the current ones, so a changed
-registry entry or budget re-runs the unit instead of mixing results. Beside it,
+registry entry or budget re-runs the unit instead of mixing results; a file that is not a
+run record at all (damaged, or edited by hand) counts as missing too, and says so. Beside it,
 ``seed<k>.json.attempts`` counts starts that never finished (the interpreter crashed or was
 killed), so the runner can try such units last and eventually give up on them.
 """
 import json
 import os
 import re
+import sys
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["unit_path", "load_unit", "save_unit", "slug", "attempts", "mark_attempt"]
+__all__ = ["unit_path", "load_unit", "save_unit", "slug", "attempts", "mark_attempt",
+           "reset_attempts"]
 
 
 def slug(label):
@@ -57,9 +61,82 @@ def _record_key(params, budget, samples):
                                              **sizes}}))
 
 
-def load_unit(path, params, budget, samples):
-    """The cached result at `path`, or None if missing, unreadable or made with other
-    parameters or another budget.
+@dataclass(frozen=True)
+class _ListOf:
+    """Shape of a JSON list: `length` items (None: any number), each of shape `item`."""
+
+    item: object
+    length: int = None
+
+
+def _record_shape(kind, budget):
+    """What the report reads from a record of a `kind` unit, as a shape for `_misfit`."""
+    result = {
+        "fqi": {"rewards": _ListOf(float, budget.iterations), "random_reward": float},
+        "rmse": {"fold_rmse": _ListOf(float, budget.rmse_folds)},
+        "dqn": {"reward": float},
+        "attention": {"world_seed": int, "reward": float, "q_values": _ListOf(float),
+                      "actions": _ListOf({"tests": _ListOf(_ListOf(float, 8)),
+                                          "type_usage": _ListOf(float)})},
+    }[kind]
+    return {"seed": int, "result": {"seconds": float, **result}}
+
+
+def _misfit(value, shape, where=""):
+    """How `value` departs from `shape`, or None if it fits.
+
+    Parameters
+    ----------
+    value : object
+        Parsed JSON.
+    shape : dict, _ListOf, int or float
+        A dict: a JSON object with (at least) these keys, each of its shape; `int`: a whole
+        number; `float`: any number.
+    where : str
+        Name of `value` in the description ("": the record).
+
+    Returns
+    -------
+    problem : str or None
+    """
+    name = where or "the record"
+    if isinstance(shape, dict):
+        if not isinstance(value, dict):
+            return f"{name} is not a JSON object"
+        for key, item in shape.items():
+            inner = f"{where}.{key}" if where else key
+            problem = f"no {inner}" if key not in value else _misfit(value[key], item, inner)
+            if problem:
+                return problem
+        return None
+    if isinstance(shape, _ListOf):
+        if not isinstance(value, list) or shape.length not in (None, len(value)):
+            return f"{name} is not a list" + ("" if shape.length is None
+                                               else f" of {shape.length}")
+        for i, item in enumerate(value):
+            problem = _misfit(item, shape.item, f"{where}[{i}]")
+            if problem:
+                return problem
+        return None
+    if isinstance(value, bool) or not isinstance(value, int if shape is int else (int, float)):
+        return f"{name} is not {'a whole number' if shape is int else 'a number'}"
+    return None
+
+
+_IGNORED = set()  # files already reported by `_ignore` in this process
+
+
+def _ignore(path, problem):
+    """Say (once per file) that the file at `path` is no run record and counts as missing."""
+    if path not in _IGNORED:
+        _IGNORED.add(path)
+        print(f"ignoring {path}: not a run record ({problem}); it counts as missing",
+              file=sys.stderr)
+
+
+def load_unit(path, params, budget, samples, seed):
+    """The cached result at `path`, or None if missing, unreadable, made with other
+    parameters or another budget, or not a run record of this unit (said on stderr).
 
     Parameters
     ----------
@@ -69,20 +146,36 @@ def load_unit(path, params, budget, samples):
     budget : Budget
     samples : int
         Samples per FQI iteration of this unit.
+    seed : int
+        The unit's seed.
 
     Returns
     -------
     record : dict or None
-        ``{"params", "budget", "experiment", "setting", "seed", "result"}``.
+        ``{"params", "budget", "experiment", "setting", "seed", "result"}``, with every
+        field the report reads.
     """
+    path = Path(path)
     try:
-        record = json.loads(Path(path).read_text())
-    except (OSError, ValueError):
+        data = path.read_bytes()
+    except OSError:
         return None
-    if {"params": record.get("params"), "budget": record.get("budget")} \
-            != _record_key(params, budget, samples):
-        return None
-    return record
+    try:
+        record = json.loads(data)
+    except (ValueError, RecursionError):  # RecursionError: nested too deep to parse
+        problem = "not readable as JSON"
+    else:
+        problem = _misfit(record, {"params": {}, "budget": {}})
+        if problem is None:
+            if {"params": record["params"], "budget": record["budget"]} \
+                    != _record_key(params, budget, samples):
+                return None  # a record of other parameters: stale, not damaged
+            problem = _misfit(record, _record_shape(params["kind"], budget)) or (
+                None if record["seed"] == seed else f"it records seed {record['seed']}")
+    if problem is None:
+        return record
+    _ignore(path, problem)
+    return None
 
 
 def save_unit(path, params, budget, samples, experiment, label, seed, result):
@@ -132,3 +225,12 @@ def mark_attempt(path):
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     _attempts_path(path).write_text(str(attempts(path) + 1))
+
+
+def reset_attempts(path, count):
+    """Set the unit's count of unfinished starts back to `count` (its start was
+    interrupted, which is no crash)."""
+    if count:
+        _attempts_path(path).write_text(str(count))
+    else:
+        _attempts_path(path).unlink(missing_ok=True)

@@ -1,38 +1,87 @@
 """Command line of ``benchmarks/run_all.py``."""
 import argparse
+import os
 import time
+from collections import Counter
+from pathlib import Path
 
 from .budgets import BUDGETS
 from .registry import EXPERIMENTS, REGISTRY
 from .report import write_outputs
-from .runner import plan, run
+from .runner import MAX_ATTEMPTS, plan, run
 
 __all__ = ["main", "parse_seeds"]
 
+# Seeds are random_state of numpy and scikit-learn: 0 .. 2**32 - 1.
+_MAX_SEED = 2**32 - 1
+# Each seed costs minutes per setting, so more is a typo: "100000" would otherwise plan
+# millions of units, filling the memory before any ran.
+_MAX_SEEDS = 1000
+
 
 def parse_seeds(text):
-    """``"3"`` -> seeds 0, 1, 2; ``"0,2"`` -> 0 and 2; ``"2-4"`` -> 2, 3, 4."""
+    """``"3"`` -> seeds 0, 1, 2; ``"0,2"`` -> 0 and 2; ``"2-4"`` -> 2, 3, 4.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        If `text` is none of these, or selects no seed, a seed twice, a seed outside
+        0 .. 2**32 - 1 or more than `_MAX_SEEDS` seeds.
+    """
     try:
         if "," in text:
-            return [int(s) for s in text.split(",") if s]
-        if "-" in text:
+            seeds = [int(s) for s in text.split(",") if s.strip()]
+        elif "-" in text:
             low, high = (int(s) for s in text.split("-"))
-            return list(range(low, high + 1))
-        return list(range(int(text)))
+            seeds = range(low, high + 1)
+        else:
+            seeds = range(int(text))
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"--seeds takes a count (3), a list (0,2,4) or a range (0-4); got {text!r}") from None
+            f"expected a count (3), a list (0,2,4) or a range (0-4), got {text!r}") from None
+    if not seeds:
+        problem = "selects no seed"
+    elif len(seeds) > _MAX_SEEDS:  # before min and max, which walk a range
+        problem = f"selects {len(seeds):,} seeds, more than {_MAX_SEEDS:,}"
+    elif min(seeds) < 0 or max(seeds) > _MAX_SEED:
+        problem = f"selects a seed outside 0 .. {_MAX_SEED}"
+    elif len(set(seeds)) < len(seeds):
+        repeated = sorted(s for s, n in Counter(seeds).items() if n > 1)
+        problem = f"repeats seed {', '.join(map(str, repeated))}"
+    else:
+        return list(seeds)
+    raise argparse.ArgumentTypeError(f"{text!r} {problem}")
 
 
 def _experiments(text):
-    if text is None:
-        return list(EXPERIMENTS)
-    names = [n.strip() for n in text.split(",") if n.strip()]
+    """``"a,b"`` -> the registry's experiments a and b (each once)."""
+    names = list(dict.fromkeys(n.strip() for n in text.split(",") if n.strip()))
     unknown = [n for n in names if n not in REGISTRY]
-    if unknown:
-        raise argparse.ArgumentTypeError(
-            f"unknown experiment(s) {', '.join(unknown)}; known: {', '.join(REGISTRY)}")
+    if not names or unknown:
+        problem = (f"unknown experiment(s) {', '.join(unknown)}" if unknown
+                   else "names no experiment")
+        raise argparse.ArgumentTypeError(f"{problem}; known: {', '.join(REGISTRY)}")
     return [REGISTRY[n] for n in names]
+
+
+def _jobs(text):
+    """``"2"`` -> 2: a whole number of parallel runs, at least 1."""
+    try:
+        jobs = int(text)
+    except ValueError:
+        jobs = None
+    if jobs is None or jobs < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number of 1 or more, got {text!r}")
+    return jobs
+
+
+def _out(text):
+    """The output folder `text`, if no file stands where it or a folder above it goes."""
+    path = Path(text)
+    existing = next((p for p in (path, *path.parents) if os.path.exists(p)), path)
+    if os.path.exists(existing) and not os.path.isdir(existing):
+        raise argparse.ArgumentTypeError(f"{existing} exists and is not a folder")
+    return text
 
 
 def _parser():
@@ -55,8 +104,9 @@ def _parser():
     parser.add_argument("--seeds", type=parse_seeds, default=None,
                         help="seeds: a count (3), a list (0,2,4) or a range (0-4); default: "
                              "the budget's")
-    parser.add_argument("--out", default="results", help="output folder (default: results)")
-    parser.add_argument("--jobs", type=int, default=1,
+    parser.add_argument("--out", type=_out, default="results",
+                        help="output folder (default: results)")
+    parser.add_argument("--jobs", type=_jobs, default=1,
                         help="parallel runs (default 1: each run already uses every core)")
     parser.add_argument("--report-only", action="store_true",
                         help="run nothing; rebuild figures and REPORT.md from cached runs")
@@ -76,16 +126,44 @@ def main(argv=None):
     -------
     report : pathlib.Path
         The written REPORT.md.
+
+    Raises
+    ------
+    SystemExit
+        Status 2 for an invalid argument; 130 on an interrupt; 1 if a file under ``--out``
+        cannot be written, or (after the report) if a unit was skipped for crashing
+        `MAX_ATTEMPTS` times. One line on stderr says why.
     """
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
     budget = BUDGETS[args.budget]
     experiments = args.only or list(EXPERIMENTS)
     start = time.perf_counter()
-    units = plan(experiments, budget, args.out, args.seeds)
-    done = [] if args.report_only else run(units, budget, args.jobs, not args.no_progress)
-    elapsed = time.perf_counter() - start
-    # a report-only invocation ran nothing: its header says so by omitting the timing
-    report = write_outputs(experiments, budget, args.out, args.seeds,
-                           None if args.report_only else elapsed, len(done))
+    try:
+        units = plan(experiments, budget, args.out, args.seeds)
+        done, skipped = ([], []) if args.report_only else run(units, budget, args.jobs,
+                                                              not args.no_progress)
+        elapsed = time.perf_counter() - start
+        # a report-only invocation ran nothing: its header says so by omitting the timing
+        report = write_outputs(experiments, budget, args.out, args.seeds,
+                               None if args.report_only else elapsed, len(done))
+    except KeyboardInterrupt:
+        parser.exit(130, f"{parser.prog}: interrupted; finished runs are cached: run the "
+                         f"same command to resume\n")
+    except OSError as error:
+        if not _under(error.filename, args.out):
+            raise
+        parser.exit(1, f"{parser.prog}: error: cannot write under --out {args.out}: "
+                       f"{error.strerror}: {error.filename}\n")
     print(f"\n{len(done)} runs in {elapsed / 60:.1f} min; report: {report}")
+    if skipped:
+        parser.exit(1, f"{parser.prog}: error: {len(skipped)} run(s) skipped after crashing "
+                       f"{MAX_ATTEMPTS} times (listed above); the report counts them as "
+                       f"missing\n")
     return report
+
+
+def _under(filename, folder):
+    """Whether `filename` (of an OSError: a path, or None) lies in `folder`."""
+    return isinstance(filename, (str, os.PathLike)) and \
+        Path(filename).resolve().is_relative_to(Path(folder).resolve())

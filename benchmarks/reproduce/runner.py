@@ -7,14 +7,14 @@ from pathlib import Path
 from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
-from .cache import attempts, load_unit, mark_attempt, save_unit, unit_path
+from .cache import attempts, load_unit, mark_attempt, reset_attempts, save_unit, unit_path
 from .registry import resolve
 from .stats import summarise
 from .units import run_unit
 
 __all__ = ["Unit", "plan", "run", "gather", "seeds_for", "MAX_ATTEMPTS"]
 
-# A unit that crashed the interpreter this many times is skipped (and reported missing).
+# A unit that crashed this many times is skipped (reported missing; the command fails).
 MAX_ATTEMPTS = 3
 
 
@@ -48,10 +48,11 @@ class Unit:
 
 
 def seeds_for(experiment, budget, seeds=None):
-    """Seeds of an experiment: `seeds` if given, else ``range(budget.seeds)``; the RMSE
-    study and the attention figure use one data set / forest (seed 0), as the thesis."""
+    """Seeds of an experiment: `seeds` if given (each once), else ``range(budget.seeds)``;
+    the RMSE study and the attention figure use one data set / forest (seed 0), as the
+    thesis."""
     if seeds is not None:
-        return list(seeds)
+        return list(dict.fromkeys(seeds))
     n = 1 if experiment.kind in ("rmse", "attention") else budget.seeds
     return list(range(n))
 
@@ -95,6 +96,9 @@ def _execute(unit, budget):
 def run(units, budget, jobs=1, progress=True):
     """Run the units not already cached; show one progress bar with ETA over all of them.
 
+    A unit's start counts as a crash until the unit finishes; an interrupt (Ctrl-C) takes
+    the count back, so only crashes get a unit skipped (after `MAX_ATTEMPTS` of them).
+
     Parameters
     ----------
     units : list of Unit
@@ -108,17 +112,21 @@ def run(units, budget, jobs=1, progress=True):
     -------
     done : list of (Unit, float)
         The units run now and their seconds (cached units are skipped).
+    skipped : list of Unit
+        The units not run because they crashed `MAX_ATTEMPTS` times.
     """
+    crashes = {u.path: attempts(u.path) for u in units
+               if load_unit(u.path, u.params, budget, u.samples, u.seed) is None}
     # Seed-major order, so an interrupted run leaves every setting with its first seeds
     # done; units that crashed before go last, and are skipped after MAX_ATTEMPTS crashes.
-    todo = sorted((u for u in units if load_unit(u.path, u.params, budget, u.samples) is None),
-                  key=lambda u: (attempts(u.path), u.seed))
+    todo = sorted((u for u in units if u.path in crashes),
+                  key=lambda u: (crashes[u.path], u.seed))
     cached = len(units) - len(todo)
-    failing = [u for u in todo if attempts(u.path) >= MAX_ATTEMPTS]
-    for u in failing:
-        print(f"skipping {u.experiment}/{u.label}/seed{u.seed}: it crashed {attempts(u.path)} "
+    skipped = [u for u in todo if crashes[u.path] >= MAX_ATTEMPTS]
+    for u in skipped:
+        print(f"skipping {u.experiment}/{u.label}/seed{u.seed}: it crashed {crashes[u.path]} "
               f"times (delete {u.path}.attempts to retry)", file=sys.stderr)
-    todo = todo[:len(todo) - len(failing)]
+    todo = todo[:len(todo) - len(skipped)]
     done = []
     with tqdm(total=sum(u.cost(budget) for u in todo), disable=not progress, unit="s",
               bar_format="{l_bar}{bar}| [{elapsed}<{remaining}]{postfix}") as bar:
@@ -128,12 +136,21 @@ def run(units, budget, jobs=1, progress=True):
         else:
             results = Parallel(n_jobs=jobs, return_as="generator_unordered")(
                 delayed(_execute)(u, budget) for u in todo)
-        for unit, seconds in results:
-            done.append((unit, seconds))
-            bar.update(unit.cost(budget))
-            bar.set_postfix_str(f"{unit.experiment}/{unit.label}/seed{unit.seed} "
-                                f"{seconds:.0f}s; {len(done)}/{len(todo)} run, {cached} cached")
-    return done
+        try:
+            for unit, seconds in results:
+                done.append((unit, seconds))
+                bar.update(unit.cost(budget))
+                bar.set_postfix_str(f"{unit.experiment}/{unit.label}/seed{unit.seed} "
+                                    f"{seconds:.0f}s; {len(done)}/{len(todo)} run, "
+                                    f"{cached} cached")
+        except KeyboardInterrupt:
+            results.close()  # stops the parallel workers before their counts are reset
+            finished = {u.path for u, _ in done}
+            for u in todo:
+                if u.path not in finished and attempts(u.path) != crashes[u.path]:
+                    reset_attempts(u.path, crashes[u.path])
+            raise
+    return done, skipped
 
 
 def gather(experiment, budget, out, seeds=None):
@@ -152,7 +169,8 @@ def gather(experiment, budget, out, seeds=None):
         params = owner.params(owner_label, budget)
         samples = int(budget.samples * owner.sample_scale)
         records = [load_unit(unit_path(out, budget, owner.name, owner_label, seed), params,
-                             budget, samples) for seed in seeds_for(experiment, budget, seeds)]
+                             budget, samples, seed)
+                   for seed in seeds_for(experiment, budget, seeds)]
         records = [r for r in records if r is not None]
         if records:
             runs[label] = records
