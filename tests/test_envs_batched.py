@@ -106,7 +106,7 @@ def test_np_random_seed_follows_gymnasium_vector_envs():
     worlds.reset(seed=[7, 3, 9])
     assert worlds.np_random_seed == (7, 3, 9)
     assert worlds.np_random.random() == np.random.default_rng([7, 3, 9]).random()
-    assert worlds.np_random_seed == (7, 3, 9)
+    assert worlds.np_random_seed == (7, 3, 9)  # reading np_random keeps it
 
 
 def test_int_seed_gives_world_i_seed_plus_i():
