@@ -3,7 +3,7 @@
 valgrind (test_boxtrees_memcheck.py) cannot execute AVX-512 instructions, so under it the
 kernels take their portable paths. AddressSanitizer instruments the compiled code instead and
 runs natively, SIMD paths included: this test builds boxtrees with it into a temporary folder
-and runs the kernel driver there.
+and runs the kernel driver there, then the mutation fuzz tests of test_boxtrees_safety.py.
 """
 import os
 import shutil
@@ -31,7 +31,8 @@ def test_kernels_have_no_invalid_memory_access_under_address_sanitizer(tmp_path)
                     ignore=shutil.ignore_patterns("*.so", "*.cpp", "__pycache__"))
     shutil.copy(ROOT / "setup.py", tmp_path)
     (tmp_path / "tests").mkdir()
-    shutil.copy(ROOT / "tests" / "kernel_driver.py", tmp_path / "tests")
+    for script in ("kernel_driver.py", "test_boxtrees_safety.py"):
+        shutil.copy(ROOT / "tests" / script, tmp_path / "tests")
     sanitize = "-fsanitize=address -fno-omit-frame-pointer"
     build = subprocess.run(
         [sys.executable, "setup.py", "build_ext", "--inplace"], cwd=tmp_path,
@@ -40,12 +41,17 @@ def test_kernels_have_no_invalid_memory_access_under_address_sanitizer(tmp_path)
     )
     assert build.returncode == 0, build.stderr[-3000:]
 
-    result = subprocess.run(
-        [sys.executable, str(tmp_path / "tests" / "kernel_driver.py")],
-        capture_output=True, text=True, timeout=600,
-        env=dict(os.environ, LD_PRELOAD=_libasan(), ASAN_OPTIONS="detect_leaks=0",
-                 PYTHONMALLOC="malloc"),
-    )
-    assert "AddressSanitizer" not in result.stderr, result.stderr[-3000:]
-    assert result.returncode == 0, result.stderr[-3000:]
-    assert "kernels ok" in result.stdout
+    env = dict(os.environ, LD_PRELOAD=_libasan(), ASAN_OPTIONS="detect_leaks=0",
+               PYTHONMALLOC="malloc")
+    # the kernels on edge cases, then the mutation fuzz tests through the public API; the
+    # sanitized build in the working directory shadows the installed one
+    for command in ([str(tmp_path / "tests" / "kernel_driver.py")],
+                    ["-c", "import boxtrees; print(boxtrees.__file__)"],
+                    ["-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/test_boxtrees_safety.py"]):
+        result = subprocess.run([sys.executable, *command], cwd=tmp_path, capture_output=True,
+                                text=True, timeout=900, env=env)
+        assert "AddressSanitizer" not in result.stderr, result.stderr[-3000:]
+        assert result.returncode == 0, (result.stdout + result.stderr)[-3000:]
+        if command[0] == "-c":
+            assert Path(result.stdout.strip()).is_relative_to(tmp_path), result.stdout
+    assert "passed" in result.stdout

@@ -1,0 +1,205 @@
+"""No value reachable from Python makes a boxtrees kernel read or write out of bounds, and
+memory follows the objects present, not the largest type id.
+
+test_boxtrees_asan.py runs this file again on an AddressSanitizer build.
+"""
+import pickle
+import tracemalloc
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from boxtrees import BoxExtraTreesRegressor, BoxTree, GridCounts, ObjectSets
+from boxtrees._builder import build_tree
+from boxtrees._predictor import PackedForest, apply_leaves, predict_mean
+
+NODE_ARRAYS = ("children_left", "children_right", "object_type", "box", "threshold", "value",
+               "impurity", "n_node_samples", "weighted_n_node_samples")
+
+
+def small_sets(rng, n, per_set=4, n_types=3):
+    return [np.column_stack([rng.uniform(-3, 3, (per_set, 2)), rng.integers(0, n_types, per_set)])
+            for _ in range(n)]
+
+
+@pytest.fixture(scope="module")
+def forest():
+    rng = np.random.default_rng(0)
+    X = small_sets(rng, 80)
+    return BoxExtraTreesRegressor(3, n_tests=10, min_samples_split=5, random_state=0).fit(
+        X, rng.normal(size=80))
+
+
+def test_a_batch_changed_after_it_was_built_gets_a_value_error(forest):
+    buf = np.zeros((8, 3), np.float32)
+    sets = ObjectSets(buf, [0, 4, 8])
+    buf[:, 2] = -1000.0           # segfaulted before the kernels checked their inputs
+    for call in (forest.predict, forest.apply, forest.decision_path,
+                 lambda X: forest.fit(X, [1.0, 2.0]),
+                 GridCounts(2, view_bounds=3).fit([np.empty((0, 3))]).transform):
+        with pytest.raises(ValueError, match="negative type ids"):
+            call(sets)
+    buf[:, 2] = 0
+    buf[5, 1] = np.nan
+    with pytest.raises(ValueError, match=r"NaN or infinite values \(object row 5"):
+        forest.predict(sets)
+    buf[5, 1] = 0
+    for offsets in ([0, 4, 10**9], [0, 6, 4], [-1, 4, 8]):
+        sets.offsets[:] = offsets
+        with pytest.raises(ValueError, match="offsets must be non-decreasing from 0"):
+            forest.predict(sets)
+    sets.offsets[:] = [0, 4, 8]
+    assert forest.predict(sets).shape == (2,)
+
+
+def test_kernels_check_their_inputs_on_every_call(forest):
+    packed = forest._packed
+    data = np.zeros((4, 3), np.float32)
+    assert predict_mean(packed, data, np.array([0, 2, 4]), np.empty(2)) == (0, -1)
+    for offsets in ([0, 2, 5], [0, 3, 2], [-1, 2, 4]):   # the offset position of the problem
+        problem, position = predict_mean(packed, data, np.array(offsets), np.empty(2))
+        assert problem == 6 and 0 <= position < 3
+    bad = data.copy()
+    bad[3] = [0.0, 0.0, 1.5]
+    assert predict_mean(packed, bad, np.array([0, 2, 4]), np.empty(2)) == (4, 3)
+    with pytest.raises(ValueError, match="out has 3 entries for 2 samples"):
+        predict_mean(packed, data, np.array([0, 2, 4]), np.empty(3))
+    with pytest.raises(ValueError, match=r"expected \(2, 3\)"):
+        apply_leaves(packed, data, np.array([0, 2, 4]), np.empty((2, 2), dtype=np.intp))
+    with pytest.raises(ValueError, match="3 columns"):
+        predict_mean(packed, np.zeros((4, 2), np.float32), np.array([0, 4]), np.empty(1))
+    with pytest.raises(TypeError):
+        predict_mean(object(), data, np.array([0, 4]), np.empty(1))
+
+
+def _build(sample_of, segment_ptr=(0, 3), n_samples=2):
+    n = len(sample_of)
+    return build_tree(np.zeros(n, np.float32), np.zeros(n, np.float32), np.asarray(sample_of),
+                      list(segment_ptr), [-np.inf, np.inf], np.zeros(n_samples), np.ones(n_samples),
+                      np.zeros((1, 4), np.float32), False, False, "fixed", 1.0, 5, 2, -1, 1, 0)
+
+
+@pytest.mark.parametrize("sample_of, segment_ptr, match", [
+    ([0, 1, 2], (0, 3), r"sample ids in \[0, 2\)"),
+    ([0, -1, 1], (0, 3), r"sample ids in \[0, 2\)"),
+    ([0, 1, 1], (0, 4), "segment_ptr must rise from 0"),
+    ([0, 1, 1], (1, 3), "segment_ptr must rise from 0"),
+    ([0, 1, 1], (0, 2, 3), "n_types \\* n_bands \\+ 1"),
+])
+def test_the_tree_builder_checks_its_index_arrays(sample_of, segment_ptr, match):
+    with pytest.raises(ValueError, match=match):
+        _build(sample_of, segment_ptr)
+    assert _build([0, 1, 1])["children_left"].shape == (1,)
+
+
+def test_tree_arrays_are_read_only_and_rebuilt_trees_are_validated(forest):
+    tree = forest[0].tree_
+    with pytest.raises(ValueError, match="read-only"):
+        tree.children_left[0] = 10**6
+    arrays = {name: np.array(getattr(tree, name)) for name in NODE_ARRAYS}
+    for name, value, match in [
+        ("children_left", 10**6, "children must be"),
+        ("children_right", 0, "children must be"),      # a cycle: the walk would never end
+        ("object_type", 7, "not one of the forest's types"),
+        ("threshold", 2**40, "int32"),
+        ("box", np.nan, "NaN box bound"),
+        ("value", np.inf, "non-finite value"),
+    ]:
+        edited = {**arrays, name: arrays[name].astype(np.float64 if name in ("box", "value") else np.int64)}
+        edited[name][0] = value
+        with pytest.raises(ValueError, match=match):
+            PackedForest([BoxTree(**edited)], forest.types_)
+    with pytest.raises(ValueError, match=r"box has shape \(\d+, 3\)"):
+        PackedForest([BoxTree(**{**arrays, "box": arrays["box"][:, :3]})], forest.types_)
+    with pytest.raises(ValueError, match="at least one tree"):
+        PackedForest([], forest.types_)
+
+
+def test_an_unpickled_forest_with_a_corrupted_tree_is_rejected(forest):
+    tree = forest[1].tree_
+    left = np.array(tree.children_left)
+    left[0] = 10**6
+    corrupted = BoxTree(**{**{name: getattr(tree, name) for name in NODE_ARRAYS}, "children_left": left})
+    edited = pickle.loads(pickle.dumps(forest))
+    edited.estimators_[1].__dict__["tree_"] = corrupted   # as a hand-edited file would hold it
+    blob = pickle.dumps(edited)
+    with pytest.raises(ValueError, match="tree 0, node 0 children must be"):
+        pickle.loads(blob)
+
+
+# --- mutation fuzzing: containers and trees changed after validation ------------------------
+
+value = st.one_of(st.floats(allow_nan=True, allow_infinity=True, width=32),
+                  st.sampled_from([-1000.0, -1.0, 0.0, 1.0, 2.0, 2.5, 2.0**24, 2.0**31, 3e38]))
+
+
+@settings(max_examples=200, deadline=None)
+@given(n_sets=st.integers(0, 6), per_set=st.integers(0, 5), data=st.data())
+def test_fuzz_batches_mutated_after_validation_predict_or_raise_value_error(forest, n_sets, per_set, data):
+    rng = np.random.default_rng(data.draw(st.integers(0, 2**32 - 1)))
+    sets = ObjectSets.from_sequence(small_sets(rng, n_sets, per_set, n_types=5))
+    for _ in range(data.draw(st.integers(1, 4))):
+        if data.draw(st.booleans()) and sets.n_objects:
+            row, col = data.draw(st.integers(0, sets.n_objects - 1)), data.draw(st.integers(0, 2))
+            sets.data[row, col] = data.draw(value)
+        else:
+            sets.offsets[data.draw(st.integers(0, n_sets))] = data.draw(st.integers(-5, 40))
+    try:
+        pred = forest.predict(sets)
+    except ValueError as error:
+        assert "offsets" in str(error) or "object row" in str(error)
+        return
+    assert pred.shape == (n_sets,) and np.isfinite(pred).all()
+
+
+int_edit = st.tuples(st.sampled_from(NODE_ARRAYS[:3] + ("threshold",)), st.integers(0, 10**6),
+                    st.integers(-3, 60) | st.sampled_from([2**31, -(2**31) - 1, 10**12]))
+float_edit = st.tuples(st.sampled_from(("box", "value")), st.integers(0, 10**6),
+                       st.floats(allow_nan=True, width=32))
+
+
+@settings(max_examples=200, deadline=None)
+@given(edits=st.lists(int_edit | float_edit, min_size=1, max_size=4))
+def test_fuzz_edited_trees_are_packed_only_when_every_walk_stays_inside(forest, edits):
+    tree = forest[0].tree_
+    arrays = {name: np.array(getattr(tree, name)) for name in NODE_ARRAYS}
+    arrays.update({name: arrays[name].astype(np.int64) for name in NODE_ARRAYS[:3] + ("threshold",)})
+    for name, node, new in edits:
+        arrays[name].reshape(tree.node_count, -1)[node % tree.node_count] = new
+    try:
+        packed = PackedForest([BoxTree(**arrays)], forest.types_)
+    except ValueError:
+        return
+    rng = np.random.default_rng(1)
+    batch = ObjectSets.from_sequence(small_sets(rng, 20))
+    out = np.empty(len(batch))
+    assert predict_mean(packed, batch.data, batch.offsets, out) == (0, -1)
+    assert np.isfinite(out).all()
+
+
+# --- type ids: accuracy and memory follow the types present ---------------------------------
+
+def test_one_object_of_a_huge_type_id_changes_neither_accuracy_nor_memory():
+    from boxtrees import make_box_regression
+
+    X, y = make_box_regression(2000, random_state=0)
+    X_test, y_test = make_box_regression(1000, random_state=1)
+    params = dict(n_estimators=10, n_tests=200, min_samples_split=10, test_width=1.5, random_state=0)
+    plain = BoxExtraTreesRegressor(**params).fit(X, y).score(X_test, y_test)
+    sets = list(X)
+    sets[0] = np.vstack([sets[0], [[0.0, 0.0, 100_000]]])
+    odd = BoxExtraTreesRegressor(**params).fit(sets, y)
+    assert odd.types_.tolist() == [0, 1, 2, 3, 100_000]
+    # before: every tree a single leaf (R^2 0), tests drawn on 100,001 mostly absent ids
+    assert plain > 0.6 and odd.score(X_test, y_test) > plain - 0.05
+    tracemalloc.start()
+    odd.predict(X_test)
+    GridCounts(4).fit(sets).transform(sets)
+    huge = [np.array([[0.0, 0.0, 2**24 - 1], [1.0, 1.0, 0]])] * 30
+    BoxExtraTreesRegressor(2, n_tests=5, min_samples_split=2).fit(huge[:3], [0.0, 1.0, 2.0]).predict(huge)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 50 * 2**20, peak        # was gigabytes: samples x (largest id + 1)
+    assert GridCounts(2).fit(huge).transform(huge).shape == (30, 2 * 2 * 2)
