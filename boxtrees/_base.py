@@ -47,12 +47,13 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
 
     def _fit_trees(self, X, y, sample_weight, seeds, n_jobs=None, verbose=0):
         """Validate the training data, set the fitted attributes and grow one tree per seed."""
-        sets, y = self._validate_input(X, y, reset=True, requires_y=True)
+        # a feature matrix stays a matrix: its columns are indexed directly
+        sets, y = self._validate_input(X, y, reset=True, requires_y=True, matrix=True)
         if not np.isfinite(y).all():
             raise ValueError("y contains NaN or infinite values")
-        # ``sizes`` stands in for X: one entry per sample, a plain NumPy array
+        # one entry per sample, a plain NumPy array, stands in for X
         sample_weight = _check_sample_weight(
-            sample_weight, sets.sizes, dtype=np.float64, ensure_non_negative=True
+            sample_weight, np.empty(len(sets), np.int8), dtype=np.float64, ensure_non_negative=True
         )
         keep = sample_weight > 0
         if not keep.all():
@@ -153,20 +154,20 @@ class _TrainingObjects:
     """
 
     def __init__(self, estimator, sets):
-        data = sets.data
         features = estimator._fitted_on_features
-        if features:
+        if features:          # ``sets`` is the feature matrix: values are x, y is 0
             estimator.types_ = np.arange(estimator.n_features_in_)
-            position = None
+            x, y = sets, np.zeros(1)
         else:
-            estimator.types_, position = np.unique(data[:, 2].astype(np.intp), return_inverse=True)
+            x, y = sets.data[:, 0], sets.data[:, 1]
+            estimator.types_, position = np.unique(sets.data[:, 2].astype(np.intp), return_inverse=True)
             if not len(estimator.types_):
                 estimator.types_ = np.zeros(1, dtype=np.intp)
         estimator.n_types_ = len(estimator.types_)
-        estimator.bounds_ = self.bounds = _sampling_region(estimator, data)
+        estimator.bounds_ = self.bounds = _sampling_region(estimator, x, y)
         self.local_x = features and estimator.view_bounds is None
         if features:
-            self._index_columns(data[:, 0].reshape(len(sets), -1))
+            self._index_columns(sets)
         else:
             self._index_objects(estimator, sets, position)
 
@@ -197,12 +198,13 @@ class _TrainingObjects:
         self.segment_ptr = np.arange(n_features + 1, dtype=np.intp) * n_samples
 
 
-def _sampling_region(estimator, data):
-    """Region ``(xmin, xmax, ymin, ymax)`` in which tests of each type are drawn."""
+def _sampling_region(estimator, x, y):
+    """Region ``(xmin, xmax, ymin, ymax)`` in which tests of each type are drawn, given the
+    coordinates of the training objects."""
     if estimator.view_bounds is not None:
         region = check_view_bounds(estimator.view_bounds)
-    elif len(data):
-        region = np.array([data[:, 0].min(), data[:, 0].max(), data[:, 1].min(), data[:, 1].max()])
+    elif x.size:
+        region = np.array([x.min(), x.max(), y.min(), y.max()])
     else:
         region = np.array([0.0, 1.0, 0.0, 1.0])
     bounds = np.tile(region, (estimator.n_types_, 1))

@@ -330,7 +330,9 @@ class ObjectInputMixin:
     or transforming with the other kind is an error.
     """
 
-    def _validate_input(self, X, y=None, *, reset, requires_y=False):
+    def _validate_input(self, X, y=None, *, reset, requires_y=False, matrix=False):
+        """Validate ``X`` (and ``y``) and return ``(sets, y)``; with ``matrix``, a feature
+        matrix is returned as the validated float32 matrix instead of as object sets."""
         from sklearn.utils.validation import check_array, column_or_1d, validate_data
 
         dense = is_feature_matrix(X)
@@ -352,7 +354,7 @@ class ObjectInputMixin:
                 X, y = validate_data(self, X, y, reset=reset, dtype=np.float32, y_numeric=True)
             else:
                 X = validate_data(self, X, reset=reset, dtype=np.float32)
-            sets = ObjectSets.from_features(X)
+            sets = X if matrix else ObjectSets.from_features(X)
         else:
             sets = as_object_sets(X)
             if reset:

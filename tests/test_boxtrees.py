@@ -269,3 +269,58 @@ def test_simd_and_portable_kernels_grow_identical_trees():
         np.testing.assert_array_equal(a.children_left, b.children_left)
         np.testing.assert_array_equal(a.box, b.box)
         np.testing.assert_array_equal(a.value, b.value)
+
+
+def test_the_forest_is_a_sequence_of_tree_estimators_as_in_scikit_learn():
+    from sklearn.base import clone
+
+    X, y = make_box_regression(400, random_state=0)
+    X_new, _ = make_box_regression(50, random_state=1)
+    forest = BoxExtraTreesRegressor(n_estimators=4, n_tests=30, min_samples_split=10,
+                                    random_state=0).fit(X, y)
+    assert len(forest) == 4 and list(forest) == forest.estimators_ and forest[-1] is forest.estimators_[3]
+    np.testing.assert_allclose(np.mean([tree.predict(X_new) for tree in forest], axis=0),
+                               forest.predict(X_new), rtol=1e-12)
+    np.testing.assert_array_equal(np.column_stack([tree.apply(X_new) for tree in forest]),
+                                  forest.apply(X_new))
+    # a tree refitted from its own parameters (random_state included) is the same tree
+    again = clone(forest[2]).fit(X, y)
+    np.testing.assert_array_equal(again.tree_.box, forest[2].tree_.box)
+    np.testing.assert_array_equal(again.predict(X_new), forest[2].predict(X_new))
+
+
+def test_decision_path_holds_the_nodes_from_the_root_to_the_leaf():
+    X, y = make_box_regression(300, random_state=0)
+    forest = BoxExtraTreesRegressor(n_estimators=3, n_tests=20, min_samples_split=10,
+                                    random_state=0).fit(X, y)
+    indicator, ptr = forest.decision_path(X[:40])
+    leaves = forest.apply(X[:40])
+    assert indicator.shape == (40, ptr[-1]) and ptr.tolist() == np.cumsum(
+        [0] + [t.tree_.node_count for t in forest]).tolist()
+    for k, estimator in enumerate(forest):
+        tree, own = estimator.tree_, estimator.decision_path(X[:40]).toarray()
+        np.testing.assert_array_equal(own, indicator[:, ptr[k]:ptr[k + 1]].toarray())
+        depth = tree.node_depth()
+        for i, leaf in enumerate(leaves[:, k]):
+            path = np.flatnonzero(own[i])
+            assert path[0] == 0 and path[-1] == leaf and len(path) == depth[leaf] + 1
+            # each node on the path is the parent of the next
+            assert all(nxt in (tree.children_left[node], tree.children_right[node])
+                       for node, nxt in zip(path[:-1], path[1:]))
+
+
+def test_random_tests_skip_constant_columns_and_columns_of_noise_width():
+    rng = np.random.default_rng(0)
+    X = np.zeros((300, 1001))
+    X[:, 500] = rng.normal(size=300)
+    y = 3 * X[:, 500]
+    # one test per node: a draw on any of the 1000 constant columns would make a leaf
+    forest = BoxExtraTreesRegressor(3, n_tests=1, max_retries=0, test_type="classic",
+                                    min_samples_split=2, random_state=0).fit(X, y)
+    assert forest.score(X, y) > 0.999
+    assert {int(t) for e in forest for t in e.tree_.object_type if t >= 0} == {500}
+    # a column whose range is below 1e-7 is constant, as in scikit-learn's trees
+    X = np.column_stack([rng.uniform(0, 5e-8, 300), rng.normal(size=300)])
+    forest = BoxExtraTreesRegressor(3, n_tests=5, test_type="classic", min_samples_split=2,
+                                    random_state=0).fit(X, X[:, 0] * 1e7 + X[:, 1])
+    assert all(0 not in e.tree_.object_type for e in forest)

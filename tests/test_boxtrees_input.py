@@ -49,6 +49,16 @@ def test_bad_fit_input_is_rejected_with_a_clear_error(X, y, error, match):
         ({"n_estimators": 0}, "n_estimators"),
         ({"n_tests": 0}, "n_tests"),
         ({"min_samples_split": -1}, "min_samples_split"),
+        ({"min_samples_split": 0}, r"min_samples_split.*int in the range \[2, inf\) or a float in the range \(0.0, 1.0\]"),
+        ({"min_samples_split": 1}, r"min_samples_split.*int in the range \[2, inf\)"),
+        ({"min_samples_split": 1.5}, r"min_samples_split.*float in the range \(0.0, 1.0\]"),
+        ({"n_tests": 2**64}, "'n_tests' parameter"),
+        ({"max_depth": 2**64}, "'max_depth' parameter"),
+        ({"max_retries": 2**64}, "'max_retries' parameter"),
+        ({"n_estimators": 2**64}, "'n_estimators' parameter"),
+        ({"view_bounds": 1e39}, "fit in float32"),
+        ({"view_bounds": (-1e300, 1e300, -1.0, 1.0)}, "fit in float32"),
+        ({"view_bounds": (1.0, 1.0 + 1e-12, 0.0, 1.0)}, "empty region in float32"),
         ({"test_type": "circle"}, "test_type"),
         ({"test_width": 0.0}, "test_width"),
         ({"test_width": -2.0}, "test_width"),
@@ -65,6 +75,31 @@ def test_bad_parameters_are_rejected_at_fit(params, match):
     forest = BoxExtraTreesRegressor(**params)  # no validation in __init__, as in scikit-learn
     with pytest.raises(ValueError, match=match):
         forest.fit(GOOD, Y)
+
+
+@pytest.mark.parametrize("position", [0, 1, 2])
+@pytest.mark.parametrize("bad, match", [
+    (np.zeros(3), r"set {} has shape \(3,\)"),
+    (None, "set {} is None"),
+    (np.zeros((2, 4)), r"set {} has shape \(2, 4\)"),
+])
+def test_a_bad_set_gets_the_same_message_at_every_position(position, bad, match):
+    X = [np.zeros((2, 3)), np.zeros((1, 3)), np.empty((0, 3))]
+    X[position] = bad
+    with pytest.raises(ValueError, match=match.format(position)):
+        small_forest().fit(X, Y)
+    fitted = small_forest().fit(GOOD, Y)
+    with pytest.raises(ValueError, match=match.format(position)):
+        fitted.predict(X)
+
+
+def test_a_pandas_series_of_sets_is_read_as_object_sets():
+    pd = pytest.importorskip("pandas")
+    series = pd.Series(GOOD, index=[10, 20, 30])
+    np.testing.assert_array_equal(small_forest().fit(series, Y).predict(series),
+                                  small_forest().fit(GOOD, Y).predict(GOOD))
+    with pytest.raises(ValueError, match=r"set 1 has shape \(3,\)"):
+        small_forest().fit(pd.Series([GOOD[0], np.zeros(3), GOOD[2]]), Y)
 
 
 def test_bad_sample_weights_are_rejected():

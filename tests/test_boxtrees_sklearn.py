@@ -1,12 +1,14 @@
 """scikit-learn's estimator checks, run on the real Cython engine (no expected failures)."""
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
-from boxtrees import BoxExtraTreesRegressor, GridCounts
+from boxtrees import BoxExtraTreeRegressor, BoxExtraTreesRegressor, GridCounts
 
-ESTIMATORS = [
-    BoxExtraTreesRegressor(n_estimators=5, test_type=test_type, random_state=0)
-    for test_type in ("fixed", "bounded", "random", "classic")
-] + [GridCounts(n_bins=4)]
+TEST_TYPES = ("fixed", "bounded", "random", "classic")
+ESTIMATORS = (
+    [BoxExtraTreesRegressor(n_estimators=5, test_type=t, random_state=0) for t in TEST_TYPES]
+    + [BoxExtraTreeRegressor(test_type=t, random_state=0) for t in TEST_TYPES]
+    + [GridCounts(n_bins=4)]
+)
 
 
 @parametrize_with_checks(ESTIMATORS, expected_failed_checks=lambda est: {})
