@@ -1,11 +1,12 @@
-"""Box-test Extra-Trees: regression forests over variable-size sets of typed 2D objects."""
+"""Box-test Extra-Trees: regression and classification forests over variable-size sets of
+typed 2D objects."""
 from ._datasets import make_box_regression
-from ._extra_tree import BoxExtraTreeRegressor
-from ._forest import BoxExtraTreesRegressor
+from ._extra_tree import BoxExtraTreeClassifier, BoxExtraTreeRegressor
+from ._forest import BoxExtraTreesClassifier, BoxExtraTreesRegressor
 from ._grid import GridCounts
 from ._objects import ObjectSets
 from ._tree import BoxTree
 
-__all__ = ["BoxExtraTreeRegressor", "BoxExtraTreesRegressor", "BoxTree", "GridCounts",
-           "ObjectSets", "make_box_regression"]
+__all__ = ["BoxExtraTreeClassifier", "BoxExtraTreeRegressor", "BoxExtraTreesClassifier",
+           "BoxExtraTreesRegressor", "BoxTree", "GridCounts", "ObjectSets", "make_box_regression"]
 __version__ = "0.1.0"

@@ -1,12 +1,15 @@
-"""What the box-test tree estimators share: parameters, growing trees, walking them."""
+"""What the box-test tree estimators share: parameters, growing trees, walking them, and the
+encoding of regression and classification targets."""
+from dataclasses import dataclass
 from math import ceil
 from numbers import Integral, Real
 
 import numpy as np
 from joblib import Parallel, delayed, effective_n_jobs
 from scipy.sparse import csr_matrix
-from sklearn.base import BaseEstimator
+from sklearn.base import BaseEstimator, ClassifierMixin, RegressorMixin
 from sklearn.utils._param_validation import Interval, RealNotInt, StrOptions
+from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import _check_sample_weight, check_is_fitted
 
 from ._builder import TEST_KINDS, build_tree
@@ -49,8 +52,7 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         """Validate the training data, set the fitted attributes and grow one tree per seed."""
         # a feature matrix stays a matrix: its columns are indexed directly
         sets, y = self._validate_input(X, y, reset=True, requires_y=True, matrix=True)
-        if not np.isfinite(y).all():
-            raise ValueError("y contains NaN or infinite values")
+        y = self._encode_targets(y)
         # one entry per sample, a plain NumPy array, stands in for X
         sample_weight = _check_sample_weight(
             sample_weight, np.empty(len(sets), np.int8), dtype=np.float64, ensure_non_negative=True
@@ -62,18 +64,20 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             raise ValueError(f"at most {_INT32_MAX - 1} samples are supported, got {len(sets)}")
         objects = _TrainingObjects(self, sets)
         split = self.min_samples_split
-        min_samples = split if isinstance(split, Integral) else max(2, ceil(split * len(sets)))
-        max_depth = -1 if self.max_depth is None else self.max_depth
-        trees = Parallel(n_jobs=n_jobs, verbose=verbose, prefer="threads")(
-            delayed(build_tree)(
-                objects.x, objects.y, objects.sample_of, objects.segment_ptr, objects.band_edges,
-                y, sample_weight, objects.bounds, objects.local_x, self._fitted_on_features,
-                self.test_type, float(self.test_width), self.n_tests, min_samples, max_depth,
-                self.max_retries, int(seed),
-            )
-            for seed in seeds
+        params = _TreeParams(
+            test_type=self.test_type, test_width=float(self.test_width), n_tests=self.n_tests,
+            min_samples_split=split if isinstance(split, Integral) else max(2, ceil(split * len(sets))),
+            max_depth=-1 if self.max_depth is None else self.max_depth,
+            max_retries=self.max_retries,
         )
-        return [BoxTree.from_positions(arrays, self.types_) for arrays in trees]
+        trees = Parallel(n_jobs=n_jobs, verbose=verbose, prefer="threads")(
+            delayed(build_tree)(objects, y, sample_weight, params, int(seed)) for seed in seeds
+        )
+        return [BoxTree.from_positions(self._node_arrays(arrays), self.types_) for arrays in trees]
+
+    def _node_arrays(self, arrays):
+        """The builder's node arrays as the estimator's trees keep them."""
+        return arrays
 
     def _pack(self, trees):
         self._packed = PackedForest(trees, self.types_)
@@ -106,7 +110,9 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         return out
 
     def _predict_mean(self, X, n_jobs=None):
-        return self._traverse(X, predict_mean, lambda n: np.empty(n, dtype=np.float64), n_jobs)
+        """Mean leaf values over the trees, shape (n_samples, n_outputs of the trees)."""
+        n_outputs = self._packed.n_outputs if "_packed" in self.__dict__ else 0
+        return self._traverse(X, predict_mean, lambda n: np.empty((n, n_outputs)), n_jobs)
 
     def _apply(self, X, n_jobs=None):
         n_trees = self._packed.n_trees if "_packed" in self.__dict__ else 0
@@ -145,6 +151,122 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             self._pack(trees)
 
 
+@dataclass(frozen=True)
+class _TreeParams:
+    """How one tree is grown (see ``boxtrees._builder.build_tree``)."""
+
+    test_type: str
+    test_width: float
+    n_tests: int
+    min_samples_split: int
+    max_depth: int
+    max_retries: int
+
+
+class RegressionTargets(RegressorMixin):
+    """Targets of a regressor: one column of real numbers, or several (multi-output).
+
+    Sets ``n_outputs_``; ``predict`` gives shape (n_samples,) for one output, else
+    (n_samples, n_outputs_).
+    """
+
+    _y_numeric = True
+
+    def _encode_targets(self, y):
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        if not np.isfinite(y).all():
+            raise ValueError("y contains NaN or infinite values")
+        self.n_outputs_ = 1 if y.ndim == 1 else y.shape[1]
+        return y
+
+    def predict(self, X):
+        """Predict the mean of the trees' leaf values.
+
+        Parameters
+        ----------
+        X : object sets or feature matrix, of the kind seen at fit
+
+        Returns
+        -------
+        y : ndarray of shape (n_samples,) or (n_samples, n_outputs_)
+        """
+        values = self._predict_mean(X, getattr(self, "n_jobs", None))
+        return values[:, 0] if self.n_outputs_ == 1 else values
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.target_tags.multi_output = True
+        return tags
+
+
+class ClassificationTargets(ClassifierMixin):
+    """Targets of a classifier: labels of any type, one column or several (multi-output).
+
+    Each output's labels become class indicator columns (a single 0/1 column for two
+    classes of a single output), the targets the regression criterion turns into Gini
+    impurity (``boxtrees/_criterion.pxd``); the trees keep each output's class frequencies.
+    Sets ``classes_``, ``n_classes_`` and ``n_outputs_`` (lists of them for several outputs).
+    """
+
+    _y_numeric = False
+
+    def _encode_targets(self, y):
+        check_classification_targets(y)
+        columns = np.asarray(y).reshape(len(y), -1)
+        classes, codes = zip(*(np.unique(c, return_inverse=True) for c in columns.T))
+        self.n_outputs_ = columns.shape[1]
+        single = self.n_outputs_ == 1
+        self.classes_ = classes[0] if single else list(classes)
+        self.n_classes_ = len(classes[0]) if single else [len(c) for c in classes]
+        if single and len(classes[0]) == 2:
+            return codes[0].astype(np.float64)
+        return np.hstack([np.eye(len(c))[code] for c, code in zip(classes, codes)])
+
+    def _node_arrays(self, arrays):
+        """Class frequencies of every output in ``value``, Gini impurity (mean over outputs)."""
+        value = arrays["value"]
+        if value.ndim == 1:         # the single indicator of a binary output: p(class 1)
+            value = np.column_stack([1.0 - value, value])
+        arrays["value"] = value
+        blocks = np.split(value, np.cumsum(np.atleast_1d(self.n_classes_))[:-1], axis=1)
+        arrays["impurity"] = np.mean([1.0 - (b * b).sum(axis=1) for b in blocks], axis=0)
+        return arrays
+
+    def predict_proba(self, X):
+        """Class probabilities: the mean over the trees of the leaves' class frequencies.
+
+        Parameters
+        ----------
+        X : object sets or feature matrix, of the kind seen at fit
+
+        Returns
+        -------
+        proba : ndarray of shape (n_samples, n_classes_), or a list of them per output
+            Columns in the order of ``classes_``.
+        """
+        values = self._predict_mean(X, getattr(self, "n_jobs", None))
+        blocks = np.split(values, np.cumsum(np.atleast_1d(self.n_classes_))[:-1], axis=1)
+        return blocks[0] if self.n_outputs_ == 1 else blocks
+
+    def predict_log_proba(self, X):
+        """Logarithm of `predict_proba` (``-inf`` for a zero probability)."""
+        proba = self.predict_proba(X)
+        with np.errstate(divide="ignore"):
+            return np.log(proba) if self.n_outputs_ == 1 else [np.log(p) for p in proba]
+
+    def predict(self, X):
+        """The most probable class of each sample (the first in ``classes_`` on a tie).
+
+        Returns
+        -------
+        y : ndarray of shape (n_samples,) or (n_samples, n_outputs_)
+        """
+        proba = self.predict_proba(X)
+        if self.n_outputs_ == 1:
+            return self.classes_.take(proba.argmax(axis=1))
+        return np.column_stack([c.take(p.argmax(axis=1)) for c, p in zip(self.classes_, proba)])
+
+
 class _TrainingObjects:
     """The training objects indexed for the tree builder.
 
@@ -166,6 +288,7 @@ class _TrainingObjects:
         estimator.n_types_ = len(estimator.types_)
         estimator.bounds_ = self.bounds = _sampling_region(estimator, x, y)
         self.local_x = features and estimator.view_bounds is None
+        self.one_per_sample = features
         if features:
             self._index_columns(sets)
         else:

@@ -25,6 +25,7 @@ from libcpp.vector cimport vector
 
 from ._rows import scan_offsets
 
+from ._criterion cimport node_statistics, split_proxy
 from ._utils cimport (
     BOUNDED, CLASSIC, FIXED, RANDOM, TREE_LEAF, TREE_UNDEFINED,
     coord_t, float64_t, int32, intp_t, uint8, uint64,
@@ -47,19 +48,23 @@ cdef struct BoxTest:
     coord_t ymin
     coord_t ymax
     int32 threshold
-    double proxy          # sum_children (sum w y)^2 / sum w: larger is a lower child variance
+    double proxy          # the criterion's split_proxy: larger is a lower child variance
 
 
-cdef struct Node:
-    intp_t left
-    intp_t right
-    int32 object_type
+cdef struct Node:         # one node of a growing tree; its values are kept beside it
+    intp_t children_left
+    intp_t children_right
+    int32 object_type     # a position in the forest's types
     coord_t box[4]
     int32 threshold
-    float64_t value
     float64_t impurity
     intp_t n_node_samples
     float64_t weighted_n_node_samples
+
+
+cdef Node _node_layout
+# the node arrays of a fitted tree (boxtrees.BoxTree), as read off the struct, plus "value"
+NODE_FIELDS = np.asarray(<Node[:1]>&_node_layout).dtype.names + ("value",)
 
 
 cdef struct StackRecord:
@@ -147,15 +152,17 @@ cdef class _Splitter:
     cdef int32* order                # scratch of split(): the old id of each new position
     cdef int32* new_id               # scratch of split(): the new id of each old one
     cdef float64_t* tmp_value        # scratch of split(): one per-sample array reordered
+    cdef float64_t* sums             # scratch of the scoring: per output, right then left sums
     cdef int32* counts
     cdef int32* hits
     cdef uint8* goes_right
     cdef intp_t* lo
     cdef intp_t* hi
     # per sample, indexed by its current id (its position in the node order)
-    cdef float64_t* target
+    cdef float64_t* target           # n_outputs per sample
     cdef float64_t* weight
     cdef float64_t* weighted_target  # weight * target
+    cdef intp_t n_outputs
     cdef double* region              # per type of the current node: x0, x1, y0, y1 of its tests
     cdef intp_t* type_size           # per type: the current node's number of objects
     cdef intp_t* live                # the types tests are drawn on in the current node
@@ -176,18 +183,18 @@ cdef class _Splitter:
     cdef intp_t start
     cdef intp_t end
     cdef double w_sum
-    cdef double wy_sum
+    cdef float64_t* wy_sum           # per output
     cdef double tie                  # proxies closer than this are ties (rounding noise)
 
-    def __cinit__(self, x, y, sample_of, intp_t max_segment, target, weight, band_edges,
-                  const coord_t[:, ::1] bounds, bint local_x, bint one_per_sample, int kind,
-                  double width, intp_t n_tests, intp_t max_retries, uint64 seed):
+    def __cinit__(self, objects, intp_t max_segment, target, weight, params, uint64 seed):
+        cdef const coord_t[:, ::1] bounds = objects.bounds
         cdef intp_t n_samples = len(target)
-        cdef intp_t n_segments = bounds.shape[0] * (len(band_edges) - 1)
+        cdef intp_t n_segments = bounds.shape[0] * (len(objects.band_edges) - 1)
         self._keep_alive = []
-        self.xs = <coord_t*>self._own(np.array(x, dtype=np.float32))
-        self.ys = <coord_t*>self._own(np.array(y, dtype=np.float32))
-        sid = np.array(sample_of, dtype=np.int32)   # checked here, on the copy the tree uses
+        self.xs = <coord_t*>self._own(np.array(objects.x, dtype=np.float32))
+        self.ys = <coord_t*>self._own(np.array(objects.y, dtype=np.float32))
+        # checked here, on the copy the tree uses
+        sid = np.array(objects.sample_of, dtype=np.int32)
         if sid.size and (sid.min() < 0 or sid.max() >= n_samples):
             raise ValueError(f"sample_of must hold sample ids in [0, {n_samples})")
         self.sid = <int32*>self._own(sid)
@@ -198,7 +205,6 @@ cdef class _Splitter:
         self.strip = <int32*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.int32))
         self.order = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
         self.new_id = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
-        self.tmp_value = <float64_t*>self._own(np.empty(n_samples, dtype=np.float64))
         self.counts = <int32*>self._own(np.zeros(n_samples, dtype=np.int32))
         # one spare slot: the branch-free scatter in count() stores a sample id before it
         # knows whether the sample is new, so with every sample hit it writes one past them
@@ -206,12 +212,17 @@ cdef class _Splitter:
         self.goes_right = <uint8*>self._own(np.zeros(n_samples, dtype=np.uint8))
         self.lo = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
         self.hi = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
-        target = np.array(target, dtype=np.float64)     # own copies: split() reorders them
+        # own copies: split() reorders them
+        target = np.array(target, dtype=np.float64).reshape(n_samples, -1)
         weight = np.array(weight, dtype=np.float64)
+        self.n_outputs = target.shape[1]
         self.target = <float64_t*>self._own(target)
         self.weight = <float64_t*>self._own(weight)
-        self.weighted_target = <float64_t*>self._own(weight * target)
-        self.edges = <const float64_t*>self._own(np.array(band_edges, dtype=np.float64))
+        self.weighted_target = <float64_t*>self._own(weight[:, None] * target)
+        self.tmp_value = <float64_t*>self._own(np.empty(n_samples * self.n_outputs, dtype=np.float64))
+        self.sums = <float64_t*>self._own(np.empty(2 * self.n_outputs, dtype=np.float64))
+        self.wy_sum = <float64_t*>self._own(np.empty(self.n_outputs, dtype=np.float64))
+        self.edges = <const float64_t*>self._own(np.array(objects.band_edges, dtype=np.float64))
         self.region = <double*>self._own(np.empty(4 * bounds.shape[0], dtype=np.float64))
         self.type_size = <intp_t*>self._own(np.empty(bounds.shape[0], dtype=np.intp))
         self.live = <intp_t*>self._own(np.arange(bounds.shape[0], dtype=np.intp))
@@ -219,16 +230,16 @@ cdef class _Splitter:
         self.bounds = bounds
         self.n_samples = n_samples
         self.n_types = bounds.shape[0]
-        self.n_bands = len(band_edges) - 1
-        self.local_x = local_x
-        self.one_per_sample = one_per_sample and self.n_bands == 1
-        self.kind = kind
-        self.width = width
-        self.n_tests = n_tests
-        self.max_retries = max_retries
+        self.n_bands = len(objects.band_edges) - 1
+        self.local_x = objects.local_x
+        self.one_per_sample = objects.one_per_sample and self.n_bands == 1
+        self.kind = TEST_KINDS[params.test_type]
+        self.width = params.test_width
+        self.n_tests = params.n_tests
+        self.max_retries = params.max_retries
         self.rng = seed
 
-    cdef void start_node(self, intp_t start, intp_t end, double w_sum, double wy_sum,
+    cdef void start_node(self, intp_t start, intp_t end, double w_sum, const float64_t* wy_sum,
                          double wy2_sum) noexcept nogil:
         """Make samples ``start:end`` (and the segment ranges ``lo:hi``) the node to split.
 
@@ -240,7 +251,8 @@ cdef class _Splitter:
         self.start = start
         self.end = end
         self.w_sum = w_sum
-        self.wy_sum = wy_sum
+        for ty in range(self.n_outputs):
+            self.wy_sum[ty] = wy_sum[ty]
         # A proxy is at most sum(w y^2); differences below this are summation-order noise,
         # and the test drawn first wins them, so equal data in another order or as repeated
         # rows instead of integer weights gives the same tree.
@@ -365,9 +377,10 @@ cdef class _Splitter:
         cdef intp_t n_hit = self.count(t, &cmax)
         cdef int32* counts = self.counts
         cdef const int32* hits = self.hits
-        cdef intp_t j
+        cdef intp_t j, k, n_outputs = self.n_outputs
         cdef int32 s
-        cdef double wr = 0.0, wyr = 0.0, wl, wyl, right
+        cdef double wr = 0.0, wyr = 0.0, right
+        cdef float64_t* right_sums = self.sums
         if n_hit == 0:
             return False
         if n_hit == self.end - self.start:     # else a sample the box missed counts zero
@@ -379,18 +392,43 @@ cdef class _Splitter:
                 counts[hits[j]] = 0
             return False
         t.threshold = cmin + 1 + <int32>rand_int(&self.rng, cmax - cmin)
-        for j in range(n_hit):                 # right-child sums, resetting the counts
-            s = hits[j]
-            c = counts[s]
-            counts[s] = 0
-            right = c >= t.threshold
-            wr += right * self.weight[s]
-            wyr += right * self.weighted_target[s]
-        wl = self.w_sum - wr
-        wyl = self.wy_sum - wyr
+        # right-child sums, resetting the counts; one output (the common case) in registers
+        if n_outputs == 1:
+            for j in range(n_hit):
+                s = hits[j]
+                c = counts[s]
+                counts[s] = 0
+                right = c >= t.threshold
+                wr += right * self.weight[s]
+                wyr += right * self.weighted_target[s]
+            right_sums[0] = wyr
+        else:
+            for k in range(n_outputs):
+                right_sums[k] = 0.0
+            for j in range(n_hit):
+                s = hits[j]
+                c = counts[s]
+                counts[s] = 0
+                right = c >= t.threshold
+                wr += right * self.weight[s]
+                for k in range(n_outputs):
+                    right_sums[k] += right * self.weighted_target[s * n_outputs + k]
+        return self._score(t, self.w_sum - wr, wr, True)
+
+    cdef inline bint _score(self, BoxTest* t, double wl, double wr, bint right) noexcept nogil:
+        """Score a test from one child's sums of weight * target, in ``sums[:n_outputs]``:
+        the right child's if ``right``, else the left's. False when a child has no weight."""
+        cdef float64_t* known = self.sums
+        cdef float64_t* other = self.sums + self.n_outputs
+        cdef intp_t k
         if wl <= 0.0 or wr <= 0.0:
             return False
-        t.proxy = wyl * wyl / wl + wyr * wyr / wr
+        for k in range(self.n_outputs):
+            other[k] = self.wy_sum[k] - known[k]
+        if right:
+            t.proxy = split_proxy(wl, other, wr, known, self.n_outputs)
+        else:
+            t.proxy = split_proxy(wl, known, wr, other, self.n_outputs)
         return True
 
     cdef bint evaluate_single(self, BoxTest* t) noexcept nogil:
@@ -401,31 +439,38 @@ cdef class _Splitter:
         its complement, with no per-sample counting.
         """
         cdef intp_t lo = self.lo[t.object_type], hi = self.hi[t.object_type], a, e, k
-        cdef const int32* sid = self.sid
-        cdef double w_in = 0.0, wy_in = 0.0, wr, wyr, wl, wyl
+        cdef double w_in
+        cdef bint inside
         _strip(self.xs, lo, hi, t.xmin, t.xmax, &a, &e)
         if e == a or e - a == hi - lo:
             return False
         t.threshold = 1 + <int32>rand_int(&self.rng, 1)   # the draw keeps evaluate's sequence
-        if 2 * (e - a) <= hi - lo:
+        inside = 2 * (e - a) <= hi - lo
+        for k in range(self.n_outputs):
+            self.sums[k] = 0.0
+        if inside:               # the strip is the right child
+            w_in = self._add_run(a, e, 0.0)
+            return self._score(t, self.w_sum - w_in, w_in, True)
+        w_in = self._add_run(e, hi, self._add_run(lo, a, 0.0))
+        return self._score(t, w_in, self.w_sum - w_in, False)
+
+    cdef inline double _add_run(self, intp_t a, intp_t e, double w) noexcept nogil:
+        """Add the weights of the samples of objects ``a:e`` to ``w`` (returned) and their
+        weight * target to ``sums[:n_outputs]``."""
+        cdef const int32* sid = self.sid
+        cdef intp_t k, o, n_outputs = self.n_outputs
+        cdef double wy = self.sums[0]
+        if n_outputs == 1:
             for k in range(a, e):
-                w_in += self.weight[sid[k]]
-                wy_in += self.weighted_target[sid[k]]
-            wr, wyr = w_in, wy_in
-            wl, wyl = self.w_sum - wr, self.wy_sum - wyr
-        else:
-            for k in range(lo, a):
-                w_in += self.weight[sid[k]]
-                wy_in += self.weighted_target[sid[k]]
-            for k in range(e, hi):
-                w_in += self.weight[sid[k]]
-                wy_in += self.weighted_target[sid[k]]
-            wl, wyl = w_in, wy_in
-            wr, wyr = self.w_sum - wl, self.wy_sum - wyl
-        if wl <= 0.0 or wr <= 0.0:
-            return False
-        t.proxy = wyl * wyl / wl + wyr * wyr / wr
-        return True
+                w += self.weight[sid[k]]
+                wy += self.weighted_target[sid[k]]
+            self.sums[0] = wy
+            return w
+        for k in range(a, e):
+            w += self.weight[sid[k]]
+            for o in range(n_outputs):
+                self.sums[o] += self.weighted_target[sid[k] * n_outputs + o]
+        return w
 
     cdef bint find_best(self, BoxTest* best) noexcept nogil:
         """Best of ``n_tests`` random tests, retried up to ``max_retries`` rounds if none splits."""
@@ -478,9 +523,9 @@ cdef class _Splitter:
                 i += 1
         for k in range(self.start, self.end):
             self.new_id[order[k]] = <int32>k
-        self._reorder(self.target)
-        self._reorder(self.weight)
-        self._reorder(self.weighted_target)
+        self._reorder(self.target, self.n_outputs)
+        self._reorder(self.weight, 1)
+        self._reorder(self.weighted_target, self.n_outputs)
         for g in range(self.n_types * self.n_bands):
             right_lo[g] = self.lo[g] + _kernels.partition(
                 self.xs + self.lo[g], self.ys + self.lo[g], self.sid + self.lo[g],
@@ -490,28 +535,35 @@ cdef class _Splitter:
             goes_right[self.hits[j]] = 0
         return i
 
-    cdef void _reorder(self, float64_t* values) noexcept nogil:
-        """Move the node's entries of a per-sample array to the samples' new ids."""
-        cdef intp_t k
+    cdef void _reorder(self, float64_t* values, intp_t width) noexcept nogil:
+        """Move the node's rows of a per-sample array (``width`` values per sample) to the
+        samples' new ids."""
+        cdef intp_t k, o
         for k in range(self.start, self.end):
-            self.tmp_value[k] = values[self.order[k]]
-        for k in range(self.start, self.end):
+            for o in range(width):
+                self.tmp_value[k * width + o] = values[self.order[k] * width + o]
+        for k in range(self.start * width, self.end * width):
             values[k] = self.tmp_value[k]
 
 
-cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segment_ptr,
-                intp_t min_samples_split, intp_t max_depth) noexcept nogil:
-    """Grow the tree depth first; ``nodes`` receives the flat node list."""
-    cdef intp_t n_segments = segment_ptr.shape[0] - 1
+cdef void _grow(_Splitter splitter, vector[Node]* nodes, vector[float64_t]* values,
+                const intp_t[::1] segment_ptr, intp_t min_samples_split,
+                intp_t max_depth) noexcept nogil:
+    """Grow the tree depth first; ``nodes`` receives the flat node list and ``values`` the
+    ``n_outputs`` values of each node, node after node."""
+    cdef intp_t n_segments = segment_ptr.shape[0] - 1, n_outputs = splitter.n_outputs
     cdef vector[StackRecord] stack
     cdef vector[intp_t] ranges          # per stacked record: (lo, hi) of every segment
     cdef vector[intp_t] right_lo
+    cdef vector[float64_t] wy           # per output
     cdef StackRecord rec
     cdef Node node
     cdef BoxTest best
-    cdef intp_t g, i, base, node_id, mid
-    cdef double w, wy, wy2, y, ymin, ymax
+    cdef intp_t g, base, node_id, mid
+    cdef double w, wy2
+    cdef bint constant
     right_lo.resize(n_segments)
+    wy.resize(n_outputs)
     stack.push_back(StackRecord(0, splitter.n_samples, 0, TREE_LEAF, False))
     for g in range(n_segments):
         ranges.push_back(segment_ptr[g])
@@ -526,35 +578,27 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segme
             splitter.hi[g] = ranges[base + 2 * g + 1]
         ranges.resize(base)
 
-        w = wy = wy2 = 0.0
-        ymin = INFINITY
-        ymax = -INFINITY
-        for i in range(rec.start, rec.end):
-            y = splitter.target[i]
-            w += splitter.weight[i]
-            wy += splitter.weight[i] * y
-            wy2 += splitter.weight[i] * y * y
-            ymin = min(ymin, y)
-            ymax = max(ymax, y)
-        node.left = node.right = TREE_LEAF
+        node_id = nodes.size()
+        values.resize((node_id + 1) * n_outputs)
+        constant = node_statistics(splitter.target, splitter.weight, rec.start, rec.end,
+                                   n_outputs, &w, wy.data(), &wy2,
+                                   values.data() + node_id * n_outputs, &node.impurity)
+        node.children_left = node.children_right = TREE_LEAF
         node.object_type = node.threshold = TREE_UNDEFINED
         node.box[0] = node.box[1] = node.box[2] = node.box[3] = 0.0
-        node.value = wy / w
-        node.impurity = max(wy2 / w - node.value * node.value, 0.0)
         node.n_node_samples = rec.end - rec.start
         node.weighted_n_node_samples = w
-        node_id = nodes.size()
         nodes.push_back(node)
         if rec.parent != TREE_LEAF:
             if rec.is_left:
-                nodes[0][rec.parent].left = node_id
+                nodes[0][rec.parent].children_left = node_id
             else:
-                nodes[0][rec.parent].right = node_id
+                nodes[0][rec.parent].children_right = node_id
 
-        if (rec.end - rec.start < max(min_samples_split, 2) or ymin == ymax
+        if (rec.end - rec.start < max(min_samples_split, 2) or constant
                 or (max_depth >= 0 and rec.depth >= max_depth)):
             continue
-        splitter.start_node(rec.start, rec.end, w, wy, wy2)
+        splitter.start_node(rec.start, rec.end, w, wy.data(), wy2)
         if not splitter.find_best(&best):
             continue
         mid = splitter.split(&best, right_lo.data())
@@ -575,35 +619,34 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, const intp_t[::1] segme
             ranges.push_back(right_lo[g])
 
 
-def build_tree(x, y, sample_of, segment_ptr, band_edges, target, weight,
-               const coord_t[:, ::1] bounds, bint local_x, bint one_per_sample, str test_type,
-               double test_width,
-               intp_t n_tests, intp_t min_samples_split, intp_t max_depth, intp_t max_retries,
-               uint64 seed):
-    """Grow one tree and return its node arrays as a dict.
+def build_tree(objects, target, weight, params, uint64 seed):
+    """Grow one tree and return its node arrays as a dict (keys `NODE_FIELDS`).
 
     Parameters
     ----------
-    x, y, sample_of : arrays of shape (n_objects,)
-        The training objects grouped by segment (type, then y band), sorted by x within each
-        segment, and the sample each belongs to.
-    segment_ptr : array of shape (n_types * n_bands + 1,)
-        Segment ``g = type * n_bands + band`` is ``segment_ptr[g]:segment_ptr[g + 1]``.
-    band_edges : array of shape (n_bands + 1,)
-        Band ``b`` holds the objects with ``band_edges[b] <= y < band_edges[b + 1]``; the
-        first edge is -inf and the last +inf.
-    target, weight : arrays of shape (n_samples,)
-        Regression targets and (strictly positive) sample weights; ``n_samples < 2**31``.
-    bounds : array of shape (n_types, 4)
-        Region ``(xmin, xmax, ymin, ymax)`` in which tests of each type are drawn; ``ymin =
-        -inf`` marks one-dimensional objects (feature-matrix columns).
-    local_x : bool
-        Draw the x extent of a test within the node's range of its type instead of ``bounds``.
-    one_per_sample : bool
-        Every sample has exactly one object of each type (a feature matrix): enables a faster,
-        equivalent scoring of tests.
-    test_type, test_width, n_tests, min_samples_split, max_depth, max_retries
-        As in ``BoxExtraTreesRegressor``; ``min_samples_split`` is a number of samples and
+    objects : object
+        The training objects indexed for the builder (``boxtrees._base._TrainingObjects``),
+        with attributes
+
+        - ``x, y, sample_of``, arrays of shape (n_objects,): the objects grouped by segment
+          (type position, then y band), sorted by x within each segment, and the sample each
+          belongs to;
+        - ``segment_ptr``, shape (n_types * n_bands + 1,): segment ``g = type * n_bands +
+          band`` is ``segment_ptr[g]:segment_ptr[g + 1]``;
+        - ``band_edges``, shape (n_bands + 1,): band ``b`` holds the objects with
+          ``band_edges[b] <= y < band_edges[b + 1]``, from -inf to +inf;
+        - ``bounds``, shape (n_types, 4): region ``(xmin, xmax, ymin, ymax)`` in which tests
+          of each type are drawn; ``ymin = -inf`` marks one-dimensional objects;
+        - ``local_x``: draw the x extent of a test within the node's range of its type;
+        - ``one_per_sample``: every sample has one object of each type (a feature matrix),
+          which enables a faster, equivalent scoring of tests.
+    target : array of shape (n_samples,) or (n_samples, n_outputs)
+        Targets (encoded class indicators for a classifier); ``n_samples < 2**31``.
+    weight : array of shape (n_samples,)
+        Strictly positive sample weights.
+    params : object
+        ``test_type, test_width, n_tests, min_samples_split, max_depth, max_retries`` as in
+        ``BoxExtraTreesRegressor``; ``min_samples_split`` is a number of samples and
         ``max_depth < 0`` means unlimited.
     seed : int
         Seed of the tree's random generator.
@@ -614,10 +657,11 @@ def build_tree(x, y, sample_of, segment_ptr, band_edges, target, weight,
         When the arrays do not fit together (the tree reads them by index, so they are
         checked, on the copies it uses, before it grows).
     """
-    segment_ptr = np.array(segment_ptr, dtype=np.intp)
-    n_objects, n_samples = len(x), len(target)
-    n_bands = len(band_edges) - 1
-    if len(y) != n_objects or len(sample_of) != n_objects:
+    segment_ptr = np.array(objects.segment_ptr, dtype=np.intp)
+    cdef const coord_t[:, ::1] bounds = objects.bounds
+    n_objects, n_samples = len(objects.x), len(target)
+    n_bands = len(objects.band_edges) - 1
+    if len(objects.y) != n_objects or len(objects.sample_of) != n_objects:
         raise ValueError("x, y and sample_of must have one entry per object")
     if len(weight) != n_samples or not 0 < n_samples < INT_MAX:
         raise ValueError(f"target and weight must have the same length, from 1 to {INT_MAX - 1}")
@@ -626,49 +670,19 @@ def build_tree(x, y, sample_of, segment_ptr, band_edges, target, weight,
                          "n_types * n_bands + 1 entries")
     if scan_offsets(segment_ptr, n_objects) != -1:
         raise ValueError(f"segment_ptr must rise from 0 to the number of objects, {n_objects}")
-    if not 0 < n_tests <= UINT_MAX or max_retries < 0:
+    if not 0 < params.n_tests <= UINT_MAX or params.max_retries < 0:
         raise ValueError(f"n_tests must be in [1, {UINT_MAX}] and max_retries >= 0")
     cdef intp_t max_segment = max(np.diff(segment_ptr).max(initial=0), 1)
-    cdef _Splitter splitter = _Splitter(
-        x, y, sample_of, max_segment, target, weight, band_edges, bounds, local_x,
-        one_per_sample, TEST_KINDS[test_type], test_width, n_tests, max_retries, seed)
+    cdef _Splitter splitter = _Splitter(objects, max_segment, target, weight, params, seed)
     cdef vector[Node] nodes
+    cdef vector[float64_t] values
     cdef const intp_t[::1] segments = segment_ptr
+    cdef intp_t min_samples_split = params.min_samples_split, max_depth = params.max_depth
     with nogil:
-        _grow(splitter, &nodes, segments, min_samples_split, max_depth)
-    return _to_arrays(nodes)
-
-
-cdef dict _to_arrays(const vector[Node]& nodes):
-    cdef intp_t n = nodes.size(), i
-    arrays = {
-        "children_left": np.empty(n, dtype=np.intp),
-        "children_right": np.empty(n, dtype=np.intp),
-        "object_type": np.empty(n, dtype=np.int32),
-        "box": np.empty((n, 4), dtype=np.float32),
-        "threshold": np.empty(n, dtype=np.int32),
-        "value": np.empty(n, dtype=np.float64),
-        "impurity": np.empty(n, dtype=np.float64),
-        "n_node_samples": np.empty(n, dtype=np.intp),
-        "weighted_n_node_samples": np.empty(n, dtype=np.float64),
-    }
-    cdef intp_t[::1] left = arrays["children_left"], right = arrays["children_right"]
-    cdef intp_t[::1] n_samples = arrays["n_node_samples"]
-    cdef int32[::1] object_type = arrays["object_type"], threshold = arrays["threshold"]
-    cdef coord_t[:, ::1] box = arrays["box"]
-    cdef float64_t[::1] value = arrays["value"], impurity = arrays["impurity"]
-    cdef float64_t[::1] weighted = arrays["weighted_n_node_samples"]
-    for i in range(n):
-        left[i] = nodes[i].left
-        right[i] = nodes[i].right
-        object_type[i] = nodes[i].object_type
-        box[i, 0] = nodes[i].box[0]
-        box[i, 1] = nodes[i].box[1]
-        box[i, 2] = nodes[i].box[2]
-        box[i, 3] = nodes[i].box[3]
-        threshold[i] = nodes[i].threshold
-        value[i] = nodes[i].value
-        impurity[i] = nodes[i].impurity
-        n_samples[i] = nodes[i].n_node_samples
-        weighted[i] = nodes[i].weighted_n_node_samples
+        _grow(splitter, &nodes, &values, segments, min_samples_split, max_depth)
+    n = nodes.size()
+    records = np.asarray(<Node[:n]>nodes.data()).copy()
+    arrays = {name: np.ascontiguousarray(records[name]) for name in records.dtype.names}
+    value = np.asarray(<float64_t[:n * splitter.n_outputs]>values.data()).reshape(n, -1)
+    arrays["value"] = value.ravel().copy() if np.ndim(target) == 1 else value.copy()
     return arrays

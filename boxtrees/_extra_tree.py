@@ -1,15 +1,16 @@
-"""``BoxExtraTreeRegressor``: one Extra-Tree whose node tests count objects in boxes."""
+"""One Extra-Tree whose node tests count objects in boxes: ``BoxExtraTreeRegressor`` and
+``BoxExtraTreeClassifier``."""
 from numbers import Integral
 
 import numpy as np
-from sklearn.base import RegressorMixin, _fit_context
+from sklearn.base import _fit_context
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import check_is_fitted
 
-from ._base import BaseBoxTrees
+from ._base import BaseBoxTrees, ClassificationTargets, RegressionTargets
 
-__all__ = ["BoxExtraTreeRegressor"]
+__all__ = ["BoxExtraTreeClassifier", "BoxExtraTreeRegressor"]
 
 _SEED_MAX = np.iinfo(np.int64).max
 
@@ -21,7 +22,87 @@ def tree_seed(random_state):
     return int(check_random_state(random_state).randint(_SEED_MAX, dtype=np.int64))
 
 
-class BoxExtraTreeRegressor(RegressorMixin, BaseBoxTrees):
+class _SingleTree(BaseBoxTrees):
+    """Fitting and walking one tree (the regressor and the classifier share it)."""
+
+    _parameter_constraints = {
+        **BaseBoxTrees._parameter_constraints,
+        "random_state": [Interval(Integral, 0, _SEED_MAX, closed="both"), "random_state"],
+    }
+
+    def __init__(
+        self,
+        *,
+        n_tests=500,
+        min_samples_split=30,
+        test_type="fixed",
+        test_width=1.0,
+        max_retries=10,
+        max_depth=None,
+        view_bounds=None,
+        random_state=None,
+    ):
+        self.n_tests = n_tests
+        self.min_samples_split = min_samples_split
+        self.test_type = test_type
+        self.test_width = test_width
+        self.max_retries = max_retries
+        self.max_depth = max_depth
+        self.view_bounds = view_bounds
+        self.random_state = random_state
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X, y, sample_weight=None):
+        """Grow the tree.
+
+        Parameters
+        ----------
+        X : sequence of array-like of shape (n_i, 3), ObjectSets, or array of shape (n_samples, n_features)
+            Object sets (rows ``[x, y, type]``; empty sets allowed), or a feature matrix.
+        y : array-like of shape (n_samples,)
+            Target values (class labels for a classifier); 2D for several outputs.
+        sample_weight : array-like of shape (n_samples,), default=None
+            Non-negative weights (see `BoxExtraTreesRegressor.fit`).
+
+        Returns
+        -------
+        self : estimator
+        """
+        (self.tree_,) = trees = self._fit_trees(X, y, sample_weight, [tree_seed(self.random_state)])
+        self._pack(trees)
+        return self
+
+    def _trees(self):
+        return [self.tree_] if "tree_" in self.__dict__ else None
+
+    def apply(self, X):
+        """Id of the leaf each sample reaches, shape (n_samples,)."""
+        return self._apply(X)[:, 0]
+
+    def decision_path(self, X):
+        """Sparse indicator of shape (n_samples, node_count): 1 for the nodes each sample
+        passes through."""
+        return self._decision_path(X, [self.tree_])[0]
+
+    def get_depth(self):
+        """Length of the longest root-to-leaf path."""
+        check_is_fitted(self)
+        return self.tree_.max_depth
+
+    def get_n_leaves(self):
+        """Number of leaves."""
+        check_is_fitted(self)
+        return self.tree_.n_leaves
+
+    @property
+    def feature_importances_(self):
+        """Impurity-based importance of each type of ``types_`` (each column for a feature
+        matrix), summing to 1 (all zeros for a single leaf), shape (n_types_,)."""
+        check_is_fitted(self)
+        return self.tree_.type_importances(self.types_)
+
+
+class BoxExtraTreeRegressor(RegressionTargets, _SingleTree):
     """One Extra-Tree over sets of 2D objects, with box-count node tests.
 
     The trees of `BoxExtraTreesRegressor` (its ``estimators_``) are of this class; fitting one
@@ -59,95 +140,40 @@ class BoxExtraTreeRegressor(RegressorMixin, BaseBoxTrees):
     >>> tree = BoxExtraTreeRegressor(min_samples_split=2, random_state=0).fit(X, [1.0, 0.0] * 10)
     >>> tree.predict([np.array([[0.5, 0.5, 0]]), np.empty((0, 3))]).tolist()
     [1.0, 0.0]
+    >>> # two leaves; a set with the object inside the root's box goes right (node 2)
     >>> tree.get_n_leaves(), tree.decision_path(X[:1]).toarray().tolist()
-    (2, [[1, 1, 0]])
+    (2, [[1, 0, 1]])
     """
 
-    _parameter_constraints = {
-        **BaseBoxTrees._parameter_constraints,
-        "random_state": [Interval(Integral, 0, _SEED_MAX, closed="both"), "random_state"],
-    }
 
-    def __init__(
-        self,
-        *,
-        n_tests=500,
-        min_samples_split=30,
-        test_type="fixed",
-        test_width=1.0,
-        max_retries=10,
-        max_depth=None,
-        view_bounds=None,
-        random_state=None,
-    ):
-        self.n_tests = n_tests
-        self.min_samples_split = min_samples_split
-        self.test_type = test_type
-        self.test_width = test_width
-        self.max_retries = max_retries
-        self.max_depth = max_depth
-        self.view_bounds = view_bounds
-        self.random_state = random_state
+class BoxExtraTreeClassifier(ClassificationTargets, _SingleTree):
+    """One Extra-Tree classifier over sets of 2D objects, with box-count node tests.
 
-    @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y, sample_weight=None):
-        """Grow the tree.
+    The trees of `BoxExtraTreesClassifier` are of this class. The split criterion is the
+    Gini impurity (see `BoxExtraTreesClassifier`); leaves hold class frequencies.
 
-        Parameters
-        ----------
-        X : sequence of array-like of shape (n_i, 3), ObjectSets, or array of shape (n_samples, n_features)
-            Object sets (rows ``[x, y, type]``; empty sets allowed), or a feature matrix.
-        y : array-like of shape (n_samples,)
-            Target values.
-        sample_weight : array-like of shape (n_samples,), default=None
-            Non-negative weights (see `BoxExtraTreesRegressor.fit`).
+    Parameters
+    ----------
+    n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, random_state
+        As in `BoxExtraTreeRegressor`.
 
-        Returns
-        -------
-        self : BoxExtraTreeRegressor
-        """
-        (self.tree_,) = trees = self._fit_trees(X, y, sample_weight, [tree_seed(self.random_state)])
-        self._pack(trees)
-        return self
+    Attributes
+    ----------
+    tree_ : BoxTree
+        The fitted tree; ``value`` holds each node's class frequencies.
+    classes_ : ndarray, or list of ndarray for several outputs
+        The class labels.
+    n_classes_ : int or list of int
+    n_outputs_ : int
+    types_, n_types_, bounds_, n_features_in_, feature_names_in_
+        As in `BoxExtraTreeRegressor`.
 
-    def _trees(self):
-        return [self.tree_] if "tree_" in self.__dict__ else None
-
-    def predict(self, X):
-        """Predict the value of the leaf each sample reaches.
-
-        Parameters
-        ----------
-        X : object sets or feature matrix, of the kind seen at fit
-
-        Returns
-        -------
-        y : ndarray of shape (n_samples,)
-        """
-        return self._predict_mean(X)
-
-    def apply(self, X):
-        """Id of the leaf each sample reaches, shape (n_samples,)."""
-        return self._apply(X)[:, 0]
-
-    def decision_path(self, X):
-        """Sparse indicator of shape (n_samples, node_count): 1 for the nodes each sample
-        passes through."""
-        return self._decision_path(X, [self.tree_])[0]
-
-    def get_depth(self):
-        """Length of the longest root-to-leaf path."""
-        check_is_fitted(self)
-        return self.tree_.max_depth
-
-    def get_n_leaves(self):
-        """Number of leaves."""
-        check_is_fitted(self)
-        return self.tree_.n_leaves
-
-    @property
-    def feature_importances_(self):
-        """Impurity-based importance of each type of ``types_`` (each column for a feature
-        matrix), summing to 1 (all zeros for a single leaf), shape (n_types_,)."""
-        check_is_fitted(self)
-        return self.tree_.type_importances(self.types_)
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from boxtrees import BoxExtraTreeClassifier
+    >>> X = [np.array([[0.5, 0.5, 0]]), np.array([[3.0, 3.0, 0]])] * 10
+    >>> tree = BoxExtraTreeClassifier(min_samples_split=2, random_state=0).fit(X, ["a", "b"] * 10)
+    >>> tree.predict([np.array([[0.5, 0.5, 0]]), np.array([[3.0, 3.0, 0]])]).tolist()
+    ['a', 'b']
+    """

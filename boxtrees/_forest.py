@@ -1,19 +1,156 @@
-"""``BoxExtraTreesRegressor``: an Extra-Trees forest whose node tests count objects in boxes."""
+"""Extra-Trees forests whose node tests count objects in boxes: ``BoxExtraTreesRegressor``
+and ``BoxExtraTreesClassifier``."""
 from numbers import Integral
 
 import numpy as np
-from sklearn.base import RegressorMixin, _fit_context
+from sklearn.base import _fit_context
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import check_is_fitted
 
-from ._base import _INT32_MAX, BaseBoxTrees
-from ._extra_tree import BoxExtraTreeRegressor
+from ._base import _INT32_MAX, BaseBoxTrees, ClassificationTargets, RegressionTargets
+from ._extra_tree import BoxExtraTreeClassifier, BoxExtraTreeRegressor
 
-__all__ = ["BoxExtraTreesRegressor"]
+__all__ = ["BoxExtraTreesClassifier", "BoxExtraTreesRegressor"]
+
+# fitted attributes a forest hands to each of its trees
+_SHARED_FITTED = ("types_", "n_types_", "bounds_", "_fitted_on_features", "n_features_in_",
+                  "feature_names_in_", "n_outputs_", "classes_", "n_classes_")
 
 
-class BoxExtraTreesRegressor(RegressorMixin, BaseBoxTrees):
+class _Forest(BaseBoxTrees):
+    """Fitting and walking a forest of trees of class ``_tree_class``."""
+
+    _parameter_constraints = {
+        **BaseBoxTrees._parameter_constraints,
+        "n_estimators": [Interval(Integral, 1, _INT32_MAX, closed="both")],
+        "n_jobs": [Integral, None],
+        "random_state": ["random_state"],
+        "verbose": ["verbose"],
+    }
+
+    def __init__(
+        self,
+        n_estimators=30,
+        *,
+        n_tests=500,
+        min_samples_split=30,
+        test_type="fixed",
+        test_width=1.0,
+        max_retries=10,
+        max_depth=None,
+        view_bounds=None,
+        n_jobs=None,
+        random_state=None,
+        verbose=0,
+    ):
+        self.n_estimators = n_estimators
+        self.n_tests = n_tests
+        self.min_samples_split = min_samples_split
+        self.test_type = test_type
+        self.test_width = test_width
+        self.max_retries = max_retries
+        self.max_depth = max_depth
+        self.view_bounds = view_bounds
+        self.n_jobs = n_jobs
+        self.random_state = random_state
+        self.verbose = verbose
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X, y, sample_weight=None):
+        """Grow the forest.
+
+        Parameters
+        ----------
+        X : sequence of array-like of shape (n_i, 3), ObjectSets, or array of shape (n_samples, n_features)
+            Object sets (rows ``[x, y, type]``; empty sets allowed), or a feature matrix.
+        y : array-like of shape (n_samples,) or (n_samples, n_outputs)
+            Target values (class labels for a classifier).
+        sample_weight : array-like of shape (n_samples,), default=None
+            Non-negative weights, each a sample's share in the node means and variances: zero
+            ignores a sample, and scaling all weights changes nothing. None gives every
+            sample weight 1.
+
+        Returns
+        -------
+        self : estimator
+        """
+        rng = check_random_state(self.random_state)
+        seeds = rng.randint(np.iinfo(np.int64).max, size=self.n_estimators, dtype=np.int64)
+        trees = self._fit_trees(X, y, sample_weight, seeds, self.n_jobs, self.verbose)
+        params = {name: getattr(self, name) for name in self._tree_class._get_param_names()
+                  if name != "random_state"}
+        fitted = {name: value for name, value in self.__dict__.items() if name in _SHARED_FITTED}
+        self.estimators_ = []
+        for tree, seed in zip(trees, seeds):
+            estimator = self._tree_class(**params, random_state=int(seed))
+            estimator.__dict__.update(fitted, tree_=tree)
+            estimator._pack([tree])
+            self.estimators_.append(estimator)
+        self._pack(trees)
+        return self
+
+    def _trees(self):
+        return [e.tree_ for e in self.estimators_] if "estimators_" in self.__dict__ else None
+
+    def apply(self, X):
+        """Index of the leaf each sample reaches in each tree.
+
+        Parameters
+        ----------
+        X : object sets or feature matrix, of the kind seen at fit
+
+        Returns
+        -------
+        leaves : ndarray of shape (n_samples, n_estimators)
+            Node ids, local to each tree (as in ``estimators_[k].tree_``).
+        """
+        return self._apply(X, self.n_jobs)
+
+    def decision_path(self, X):
+        """The nodes each sample passes through, in every tree.
+
+        Parameters
+        ----------
+        X : object sets or feature matrix, of the kind seen at fit
+
+        Returns
+        -------
+        indicator : sparse matrix of shape (n_samples, n_nodes)
+            1 where a sample passes through a node; the trees' nodes side by side.
+        n_nodes_ptr : ndarray of shape (n_estimators + 1,)
+            Columns ``n_nodes_ptr[k]:n_nodes_ptr[k + 1]`` are tree ``k``'s nodes.
+        """
+        check_is_fitted(self)
+        return self._decision_path(X, self._trees(), self.n_jobs)
+
+    @property
+    def feature_importances_(self):
+        """Impurity-based importance of each type of ``types_`` (each column for a feature
+        matrix): the weighted variance reduction of the tests on it, normalised per tree,
+        averaged over trees, summing to 1 (all zeros if no tree splits).
+
+        Returns
+        -------
+        importances : ndarray of shape (n_types_,)
+        """
+        check_is_fitted(self)
+        total = np.mean([t.type_importances(self.types_) for t in self._trees()], axis=0)
+        return total / total.sum() if total.sum() > 0 else total
+
+    def __len__(self):
+        """Number of fitted trees."""
+        return len(self.estimators_)
+
+    def __getitem__(self, index):
+        """The ``index``-th fitted tree."""
+        return self.estimators_[index]
+
+    def __iter__(self):
+        return iter(self.estimators_)
+
+
+class BoxExtraTreesRegressor(RegressionTargets, _Forest):
     """Extra-Trees regression over sets of 2D objects, with box-count node tests.
 
     Each sample is a set of objects ``[x, y, type]`` of any size (possibly empty). A node test
@@ -119,145 +256,51 @@ class BoxExtraTreesRegressor(RegressorMixin, BaseBoxTrees):
     [1.0, 0.0, 0.0]
     """
 
-    _parameter_constraints = {
-        **BaseBoxTrees._parameter_constraints,
-        "n_estimators": [Interval(Integral, 1, _INT32_MAX, closed="both")],
-        "n_jobs": [Integral, None],
-        "random_state": ["random_state"],
-        "verbose": ["verbose"],
-    }
+    _tree_class = BoxExtraTreeRegressor
 
-    def __init__(
-        self,
-        n_estimators=30,
-        *,
-        n_tests=500,
-        min_samples_split=30,
-        test_type="fixed",
-        test_width=1.0,
-        max_retries=10,
-        max_depth=None,
-        view_bounds=None,
-        n_jobs=None,
-        random_state=None,
-        verbose=0,
-    ):
-        self.n_estimators = n_estimators
-        self.n_tests = n_tests
-        self.min_samples_split = min_samples_split
-        self.test_type = test_type
-        self.test_width = test_width
-        self.max_retries = max_retries
-        self.max_depth = max_depth
-        self.view_bounds = view_bounds
-        self.n_jobs = n_jobs
-        self.random_state = random_state
-        self.verbose = verbose
 
-    @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y, sample_weight=None):
-        """Grow the forest.
+class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
+    """Extra-Trees classification over sets of 2D objects, with box-count node tests.
 
-        Parameters
-        ----------
-        X : sequence of array-like of shape (n_i, 3), ObjectSets, or array of shape (n_samples, n_features)
-            Object sets (rows ``[x, y, type]``; empty sets allowed), or a feature matrix.
-        y : array-like of shape (n_samples,)
-            Target values.
-        sample_weight : array-like of shape (n_samples,), default=None
-            Non-negative weights, each a sample's share in the node means and variances: zero
-            ignores a sample, and scaling all weights changes nothing. None gives every
-            sample weight 1.
+    The forest of `BoxExtraTreesRegressor` with a classification criterion: the Gini
+    impurity, which for class indicator targets is the variance the regressor reduces, so
+    the same engine grows both (``boxtrees/_criterion.pxd``); each leaf keeps the class
+    frequencies of its training samples and ``predict_proba`` averages them over the trees.
+    Labels may be of any type; several outputs (2D ``y``) are classified at once, as in
+    scikit-learn's ``ExtraTreesClassifier``.
 
-        Returns
-        -------
-        self : BoxExtraTreesRegressor
-        """
-        rng = check_random_state(self.random_state)
-        seeds = rng.randint(np.iinfo(np.int64).max, size=self.n_estimators, dtype=np.int64)
-        trees = self._fit_trees(X, y, sample_weight, seeds, self.n_jobs, self.verbose)
-        params = {name: getattr(self, name) for name in BoxExtraTreeRegressor._get_param_names()
-                  if name != "random_state"}
-        fitted = {name: value for name, value in self.__dict__.items()
-                  if name in ("types_", "n_types_", "bounds_", "_fitted_on_features",
-                              "n_features_in_", "feature_names_in_")}
-        self.estimators_ = []
-        for tree, seed in zip(trees, seeds):
-            estimator = BoxExtraTreeRegressor(**params, random_state=int(seed))
-            estimator.__dict__.update(fitted, tree_=tree)
-            estimator._pack([tree])
-            self.estimators_.append(estimator)
-        self._pack(trees)
-        return self
+    Parameters
+    ----------
+    n_estimators, n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, n_jobs, random_state, verbose
+        As in `BoxExtraTreesRegressor`.
 
-    def _trees(self):
-        return [e.tree_ for e in self.estimators_] if "estimators_" in self.__dict__ else None
+    Attributes
+    ----------
+    estimators_ : list of BoxExtraTreeClassifier
+        The fitted trees (also ``forest[k]``, ``len(forest)``, ``iter(forest)``).
+    classes_ : ndarray, or list of ndarray for several outputs
+        The class labels, in the column order of ``predict_proba``.
+    n_classes_ : int or list of int
+    n_outputs_ : int
+    types_, n_types_, bounds_, n_features_in_, feature_names_in_
+        As in `BoxExtraTreesRegressor`.
 
-    def predict(self, X):
-        """Predict the mean of the trees' leaf values.
+    Examples
+    --------
+    Is there an object of type 0 in the unit square around the origin?
 
-        Parameters
-        ----------
-        X : object sets or feature matrix, of the kind seen at fit
+    >>> import numpy as np
+    >>> from boxtrees import BoxExtraTreesClassifier
+    >>> rng = np.random.default_rng(0)
+    >>> X = [np.column_stack([rng.uniform(-3, 3, (k, 2)), rng.integers(0, 2, k)])
+    ...      for k in rng.integers(0, 12, 1500)]
+    >>> y = ["yes" if ((np.abs(s[:, :2]).max(1) < 1) & (s[:, 2] == 0)).any() else "no" for s in X]
+    >>> forest = BoxExtraTreesClassifier(n_estimators=10, min_samples_split=5,
+    ...                                  random_state=0).fit(X[:1000], y[:1000])
+    >>> forest.classes_.tolist(), bool(forest.score(X[1000:], y[1000:]) > 0.9)
+    (['no', 'yes'], True)
+    >>> forest.predict([np.array([[0.0, 0.0, 0]]), np.array([[0.0, 0.0, 1]])]).tolist()
+    ['yes', 'no']
+    """
 
-        Returns
-        -------
-        y : ndarray of shape (n_samples,)
-        """
-        return self._predict_mean(X, self.n_jobs)
-
-    def apply(self, X):
-        """Index of the leaf each sample reaches in each tree.
-
-        Parameters
-        ----------
-        X : object sets or feature matrix, of the kind seen at fit
-
-        Returns
-        -------
-        leaves : ndarray of shape (n_samples, n_estimators)
-            Node ids, local to each tree (as in ``estimators_[k].tree_``).
-        """
-        return self._apply(X, self.n_jobs)
-
-    def decision_path(self, X):
-        """The nodes each sample passes through, in every tree.
-
-        Parameters
-        ----------
-        X : object sets or feature matrix, of the kind seen at fit
-
-        Returns
-        -------
-        indicator : sparse matrix of shape (n_samples, n_nodes)
-            1 where a sample passes through a node; the trees' nodes side by side.
-        n_nodes_ptr : ndarray of shape (n_estimators + 1,)
-            Columns ``n_nodes_ptr[k]:n_nodes_ptr[k + 1]`` are tree ``k``'s nodes.
-        """
-        check_is_fitted(self)
-        return self._decision_path(X, self._trees(), self.n_jobs)
-
-    @property
-    def feature_importances_(self):
-        """Impurity-based importance of each type of ``types_`` (each column for a feature
-        matrix): the weighted variance reduction of the tests on it, normalised per tree,
-        averaged over trees, summing to 1 (all zeros if no tree splits).
-
-        Returns
-        -------
-        importances : ndarray of shape (n_types_,)
-        """
-        check_is_fitted(self)
-        total = np.mean([t.type_importances(self.types_) for t in self._trees()], axis=0)
-        return total / total.sum() if total.sum() > 0 else total
-
-    def __len__(self):
-        """Number of fitted trees."""
-        return len(self.estimators_)
-
-    def __getitem__(self, index):
-        """The ``index``-th fitted tree, a `BoxExtraTreeRegressor`."""
-        return self.estimators_[index]
-
-    def __iter__(self):
-        return iter(self.estimators_)
+    _tree_class = BoxExtraTreeClassifier

@@ -4,6 +4,7 @@ An object is a row ``[x, y, type]``: a position and a non-negative integer type 
 set of objects (possibly empty). A batch of samples is stored as one ``(n_objects, 3)`` float32
 array plus offsets, so it is cheap to build, slice and hand to the Cython core.
 """
+import warnings
 from numbers import Integral
 
 import numpy as np
@@ -300,6 +301,22 @@ def as_object_sets(X):
     return ObjectSets.from_sequence(list(X) if hasattr(X, "iloc") else X)
 
 
+def _check_targets(y):
+    """``y`` as one column (1D) or several (2D); a column vector becomes 1D, with the
+    warning scikit-learn gives."""
+    from sklearn.exceptions import DataConversionWarning
+
+    y = np.asarray(y)
+    if y.ndim == 2 and y.shape[1] == 1:
+        warnings.warn("A column-vector y was passed when a 1d array was expected. Please "
+                      "change the shape of y to (n_samples,), for example using ravel().",
+                      DataConversionWarning, stacklevel=4)
+        y = y[:, 0]
+    if y.ndim not in (1, 2) or (y.ndim == 2 and y.shape[1] == 0):
+        raise ValueError(f"y must have shape (n_samples,) or (n_samples, n_outputs); got {y.shape}")
+    return y
+
+
 def check_view_bounds(view_bounds):
     """Validate ``view_bounds`` (``(xmin, xmax, ymin, ymax)`` or a half-width ``r`` for
     ``[-r, r]^2``) and return it as a float array of 4."""
@@ -333,7 +350,7 @@ class ObjectInputMixin:
     def _validate_input(self, X, y=None, *, reset, requires_y=False, matrix=False):
         """Validate ``X`` (and ``y``) and return ``(sets, y)``; with ``matrix``, a feature
         matrix is returned as the validated float32 matrix instead of as object sets."""
-        from sklearn.utils.validation import check_array, column_or_1d, validate_data
+        from sklearn.utils.validation import check_array, validate_data
 
         dense = is_feature_matrix(X)
         if not reset:
@@ -351,7 +368,8 @@ class ObjectInputMixin:
                 )
         if dense:
             if requires_y:
-                X, y = validate_data(self, X, y, reset=reset, dtype=np.float32, y_numeric=True)
+                X, y = validate_data(self, X, y, reset=reset, dtype=np.float32,
+                                     multi_output=True, y_numeric=self._y_numeric)
             else:
                 X = validate_data(self, X, reset=reset, dtype=np.float32)
             sets = X if matrix else ObjectSets.from_features(X)
@@ -365,11 +383,12 @@ class ObjectInputMixin:
             if requires_y:
                 if y is None:
                     raise ValueError(f"{type(self).__name__} requires y to be passed, but the target y is None")
-                y = column_or_1d(check_array(y, ensure_2d=False, dtype=np.float64, input_name="y"), warn=True)
+                y = check_array(y, ensure_2d=False, dtype=np.float64 if self._y_numeric else None,
+                                input_name="y")
         if reset:
             self._fitted_on_features = dense
         if requires_y:
-            y = np.ascontiguousarray(y, dtype=np.float64)
+            y = _check_targets(y)
             if len(y) != len(sets):
                 raise ValueError(f"X has {len(sets)} samples but y has {len(y)}")
         return sets, y

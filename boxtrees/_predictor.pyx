@@ -53,7 +53,7 @@ cdef coord_t _NO_OBJECT = 0
 
 _NODE_FIELDS = {  # BoxTree array -> (dtype kind, trailing shape)
     "children_left": ("i", ()), "children_right": ("i", ()), "object_type": ("i", ()),
-    "threshold": ("i", ()), "box": ("f", (4,)), "value": ("f", ()),
+    "threshold": ("i", ()), "box": ("f", (4,)), "value": ("f", None),   # None: any width
 }
 _INT32 = np.iinfo(np.int32)
 
@@ -69,9 +69,10 @@ def _set_simd(bint enabled):
 
 cdef struct ForestView:
     const boxtrees_node* nodes
-    const float64_t* value       # per node (the prediction at leaves)
+    const float64_t* value       # n_outputs per node (the prediction at leaves)
     const intp_t* tree_offsets   # first node of each tree
     intp_t n_trees
+    intp_t n_outputs
 
 
 def _tree_arrays(k, tree):
@@ -82,12 +83,14 @@ def _tree_arrays(k, tree):
         if array.dtype.kind not in (kind, "u" if kind == "i" else kind):
             raise ValueError(f"tree {k}: {name} must be an array of {'integers' if kind == 'i' else 'floats'}, got {array.dtype}")
         arrays[name] = array
-    n = len(arrays["value"]) if arrays["value"].ndim == 1 else -1
+    n = len(arrays["value"]) if arrays["value"].ndim in (1, 2) else -1
     if not 0 < n < _INT32.max:
-        raise ValueError(f"tree {k}: value must be a 1D array of 1 to {_INT32.max - 1} nodes")
+        raise ValueError(f"tree {k}: value must be a 1D or 2D array of 1 to {_INT32.max - 1} nodes")
+    arrays["value"] = arrays["value"].reshape(n, -1)
     for name, (kind, tail) in _NODE_FIELDS.items():
-        if arrays[name].shape != (n, *tail):
-            raise ValueError(f"tree {k}: {name} has shape {arrays[name].shape}; {n} nodes need {(n, *tail)}")
+        shape = (n, *(tail if tail is not None else arrays[name].shape[1:]))
+        if arrays[name].shape != shape:
+            raise ValueError(f"tree {k}: {name} has shape {arrays[name].shape}; {n} nodes need {shape}")
     return arrays
 
 
@@ -115,6 +118,7 @@ cdef class PackedForest:
     cdef ForestView _view
     cdef const intp_t* _types
     cdef readonly intp_t n_trees
+    cdef readonly intp_t n_outputs
     cdef readonly intp_t n_types
     cdef bint _dense            # types are 0 .. n_types - 1: an id is its own position
 
@@ -125,6 +129,9 @@ cdef class PackedForest:
         per_tree = [_tree_arrays(k, tree) for k, tree in enumerate(trees)]
         if not per_tree:
             raise ValueError("a forest needs at least one tree")
+        n_outputs = per_tree[0]["value"].shape[1]
+        if any(a["value"].shape[1] != n_outputs for a in per_tree):
+            raise ValueError("the trees of a forest must have the same number of outputs")
         counts = np.array([len(a["value"]) for a in per_tree], dtype=np.intp)
         offsets = np.zeros(len(counts) + 1, dtype=np.intp)
         np.cumsum(counts, out=offsets[1:])
@@ -147,7 +154,7 @@ cdef class PackedForest:
             (inner & ((threshold < _INT32.min) | (threshold > _INT32.max)),
              "has a threshold outside the int32 range"),
             (inner & np.isnan(cat["box"]).any(axis=1), "has a NaN box bound"),
-            (~np.isfinite(cat["value"]), "has a non-finite value"),
+            (~np.isfinite(cat["value"]).all(axis=1), "has a non-finite value"),
         ]
         for bad, what in problems:
             if bad.any():
@@ -166,6 +173,7 @@ cdef class PackedForest:
         self._view.value = <const float64_t*>cnp.PyArray_DATA(value)
         self._view.tree_offsets = <const intp_t*>cnp.PyArray_DATA(offsets)
         self._view.n_trees = self.n_trees = len(counts)
+        self._view.n_outputs = self.n_outputs = n_outputs
         self._types = <const intp_t*>cnp.PyArray_DATA(types)
         self.n_types = len(types)
         self._dense = types.max() == len(types) - 1
@@ -252,40 +260,45 @@ cdef void _walk(const ForestView* forest, const coord_t* x, const coord_t* y, co
 
     Sample ``i``'s objects of type position ``d`` are ``x[type_ptr[i * stride + d]:type_ptr[i
     * stride + d + 1]]`` (and ``y``). Writes the mean leaf value per sample into ``mean`` or,
-    when ``mean`` is NULL, the tree-local leaf ids into the (n_samples, n_trees) ``leaves``.
+    when ``mean`` is NULL, the tree-local leaf ids into the (n_samples, n_trees) ``leaves``;
+    ``mean`` holds ``n_outputs`` values per sample.
     """
     cdef const boxtrees_node* nodes = forest.nodes
     cdef const intp_t* tree_offsets = forest.tree_offsets
     cdef const float64_t* value = forest.value
-    cdef intp_t n_trees = forest.n_trees, block = 0, block_end, tree, i, leaf
+    cdef intp_t n_trees = forest.n_trees, n_outputs = forest.n_outputs
+    cdef intp_t block = 0, block_end, tree, i, k, leaf
     while block < n_samples:
         block_end = min(block + <intp_t>BLOCK, n_samples)
         if mean != NULL:
-            for i in range(block, block_end):
+            for i in range(block * n_outputs, block_end * n_outputs):
                 mean[i] = 0.0
         for tree in range(n_trees):
             for i in range(block, block_end):
                 leaf = _kernels.find_leaf(nodes + tree_offsets[tree], x, y, type_ptr + i * stride)
-                if mean != NULL:
-                    mean[i] += value[tree_offsets[tree] + leaf]
-                else:
+                if mean == NULL:
                     leaves[i * n_trees + tree] = leaf
+                    continue
+                leaf = (tree_offsets[tree] + leaf) * n_outputs
+                for k in range(n_outputs):
+                    mean[i * n_outputs + k] += value[leaf + k]
         if mean != NULL:
-            for i in range(block, block_end):
+            for i in range(block * n_outputs, block_end * n_outputs):
                 mean[i] /= n_trees
         block = block_end
 
 
 def predict_mean(PackedForest forest, const coord_t[:, ::1] data, const intp_t[::1] offsets,
-                 float64_t[::1] out):
-    """Write the mean leaf value over the trees of each sample into ``out``.
+                 float64_t[:, ::1] out):
+    """Write the mean leaf values over the trees of each sample into ``out``.
 
     Sample ``i`` is ``data[offsets[i]:offsets[i + 1]]`` (rows ``[x, y, type]``); ``out`` has
-    one entry per sample. Returns ``(problem, row)`` as ``PackedForest._run``.
+    shape (n_samples, n_outputs). Returns ``(problem, row)`` as ``PackedForest._run``.
     """
-    if out.shape[0] != offsets.shape[0] - 1:
-        raise ValueError(f"out has {out.shape[0]} entries for {offsets.shape[0] - 1} samples")
-    return forest._run(data, offsets, &out[0] if out.shape[0] else NULL, NULL)
+    if out.shape[0] != offsets.shape[0] - 1 or out.shape[1] != forest.n_outputs:
+        raise ValueError(f"out has shape {tuple(out.shape)[:2]}; expected "
+                         f"({offsets.shape[0] - 1}, {forest.n_outputs})")
+    return forest._run(data, offsets, &out[0, 0] if out.shape[0] else NULL, NULL)
 
 
 def apply_leaves(PackedForest forest, const coord_t[:, ::1] data, const intp_t[::1] offsets,

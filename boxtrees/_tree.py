@@ -1,22 +1,12 @@
 """Fitted box-test trees as flat node arrays."""
 import numpy as np
 
+from ._builder import NODE_FIELDS
+
 __all__ = ["BoxTree", "TREE_LEAF", "TREE_UNDEFINED"]
 
 TREE_LEAF = -1
 TREE_UNDEFINED = -2
-
-_NODE_ARRAYS = (
-    "children_left",
-    "children_right",
-    "object_type",
-    "box",
-    "threshold",
-    "value",
-    "impurity",
-    "n_node_samples",
-    "weighted_n_node_samples",
-)
 
 
 class BoxTree:
@@ -36,10 +26,12 @@ class BoxTree:
         unbounded (classic half-plane tests, feature-matrix columns). Zeros at leaves.
     threshold : ndarray of shape (node_count,)
         Integer count threshold ``z``; ``-2`` at leaves.
-    value : ndarray of shape (node_count,)
-        Weighted mean target of the node's training samples (the prediction at leaves).
+    value : ndarray of shape (node_count,) or (node_count, n_outputs)
+        Weighted mean target of the node's training samples (the prediction at leaves); for
+        a classifier, the class frequencies of each output.
     impurity : ndarray of shape (node_count,)
-        Weighted target variance of the node's training samples.
+        Weighted target variance of the node's training samples (averaged over outputs),
+        or for a classifier their Gini impurity.
     n_node_samples, weighted_n_node_samples : ndarray of shape (node_count,)
         Number and total weight of training samples reaching each node.
 
@@ -48,10 +40,10 @@ class BoxTree:
     """
 
     def __init__(self, **arrays):
-        missing = set(_NODE_ARRAYS) - set(arrays)
+        missing = set(NODE_FIELDS) - set(arrays)
         if missing:
             raise TypeError(f"missing node arrays: {sorted(missing)}")
-        for name in _NODE_ARRAYS:
+        for name in NODE_FIELDS:
             array = np.array(arrays[name])
             array.flags.writeable = False
             setattr(self, name, array)

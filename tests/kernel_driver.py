@@ -8,6 +8,7 @@ Imports only NumPy and the extension modules (not scikit-learn), to stay fast un
 import importlib
 import sys
 import types
+from types import SimpleNamespace
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,18 @@ _builder = importlib.import_module("boxtrees._builder")
 _predictor = importlib.import_module("boxtrees._predictor")
 _rows = importlib.import_module("boxtrees._rows")
 _tree = importlib.import_module("boxtrees._tree")
-_NODE_ARRAYS = _tree._NODE_ARRAYS
+_NODE_ARRAYS = _builder.NODE_FIELDS
+
+
+def grow(x, y, sample, segment_ptr, edges, target, weight, bounds, test_type, width=0.7,
+         n_tests=20, seed=0, features=False):
+    """One tree from the builder, with small parameters."""
+    objects = SimpleNamespace(x=x, y=y, sample_of=sample, segment_ptr=segment_ptr,
+                              band_edges=edges, bounds=bounds, local_x=features,
+                              one_per_sample=features)
+    params = SimpleNamespace(test_type=test_type, test_width=width, n_tests=n_tests,
+                             min_samples_split=2, max_depth=-1, max_retries=2)
+    return _builder.build_tree(objects, target, weight, params, seed)
 
 
 def training_arrays(rng, n, per_sample, n_types, n_bands, spread):
@@ -57,11 +69,13 @@ def main():
             for simd in (True, False):
                 _builder._set_simd(simd)
                 _predictor._set_simd(simd)
-                trees = [_tree.BoxTree(**_builder.build_tree(
-                    x, y, sample, segment_ptr, edges, target, weight, bounds, False, False,
-                    test_type, 0.7, 20, 2, -1, 2, seed)) for seed in range(3)]
+                # one output, then two (multi-output sums)
+                targets = target if seed_outputs(case) == 1 else np.column_stack([target, weight])
+                trees = [_tree.BoxTree(**grow(x, y, sample, segment_ptr, edges, targets, weight,
+                                              bounds, test_type, seed=seed)) for seed in range(3)]
                 forest = _predictor.PackedForest(trees, np.arange(n_types))
-                assert _predictor.predict_mean(forest, data, offsets, np.empty(n)) == (0, -1)
+                out = np.empty((n, forest.n_outputs))
+                assert _predictor.predict_mean(forest, data, offsets, out) == (0, -1)
                 leaves = np.empty((n, 3), dtype=np.intp)
                 assert _predictor.apply_leaves(forest, data, offsets, leaves) == (0, -1)
                 corrupted_inputs(forest, trees, data, offsets)
@@ -75,17 +89,23 @@ def main():
     segment_ptr = np.arange(0, n * n_features + 1, n).astype(np.intp)
     bounds = np.tile(np.array([0, 0, -np.inf, np.inf], dtype=np.float32), (n_features, 1))
     for test_type in ("classic", "random", "fixed"):
-        _builder.build_tree(x, np.zeros_like(x), sample, segment_ptr, np.array([-np.inf, np.inf]),
-                            rng.normal(size=n), np.ones(n), bounds, True, True, test_type, 0.3,
-                            n_features, 2, -1, 2, 1)
+        for targets in (rng.normal(size=n), rng.normal(size=(n, 3))):
+            grow(x, np.zeros_like(x), sample, segment_ptr, np.array([-np.inf, np.inf]), targets,
+                 np.ones(n), bounds, test_type, width=0.3, n_tests=n_features, seed=1,
+                 features=True)
     print("kernels ok")
+
+
+def seed_outputs(case):
+    """Number of target columns of a case: even cases have one, odd ones two."""
+    return 1 + case % 2
 
 
 def corrupted_inputs(forest, trees, data, offsets):
     """Inputs a validated batch or tree may turn into: each kernel reports them (a problem
     code, or a ValueError), and reads or writes nothing outside its arrays."""
     n = len(offsets) - 1
-    out = np.empty(n)
+    out = np.empty((n, forest.n_outputs))
     rows = data.copy()
     if len(rows):
         rows[len(rows) // 2, 2] = -1000.0
@@ -94,7 +114,8 @@ def corrupted_inputs(forest, trees, data, offsets):
         assert _predictor.predict_mean(forest, rows, offsets, out)[0] == 0
     for bad in ([0, len(data) + 1], [-1, 0], [0, 1, 0] if len(data) else [1, 0]):
         bad = np.array(bad, dtype=np.intp)
-        assert _predictor.predict_mean(forest, data, bad, np.empty(len(bad) - 1))[0] != 0
+        assert _predictor.predict_mean(forest, data, bad,
+                                       np.empty((len(bad) - 1, forest.n_outputs)))[0] != 0
     raised = 0
     for change in ({"children_left": 10**6}, {"children_left": 0}, {"object_type": 99},
                    {"threshold": 2**40}, {"box": np.nan}, {"value": np.inf}):
@@ -110,10 +131,9 @@ def corrupted_inputs(forest, trees, data, offsets):
     assert raised == 6 or trees[0].node_count == 1, raised
     sample = np.array(trees[0].children_left)   # not a sample id: out of range for some
     try:
-        _builder.build_tree(np.zeros(len(sample), np.float32), np.zeros(len(sample), np.float32),
-                            sample, [0, len(sample)], [-np.inf, np.inf], np.zeros(2), np.ones(2),
-                            np.zeros((1, 4), np.float32), False, False, "fixed", 1.0, 5, 2, -1,
-                            1, 0)
+        grow(np.zeros(len(sample), np.float32), np.zeros(len(sample), np.float32), sample,
+             [0, len(sample)], [-np.inf, np.inf], np.zeros(2), np.ones(2),
+             np.zeros((1, 4), np.float32), "fixed")
     except ValueError:
         pass
     else:

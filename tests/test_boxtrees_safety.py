@@ -5,6 +5,7 @@ test_boxtrees_asan.py runs this file again on an AddressSanitizer build.
 """
 import pickle
 import tracemalloc
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -57,28 +58,32 @@ def test_a_batch_changed_after_it_was_built_gets_a_value_error(forest):
 def test_kernels_check_their_inputs_on_every_call(forest):
     packed = forest._packed
     data = np.zeros((4, 3), np.float32)
-    assert predict_mean(packed, data, np.array([0, 2, 4]), np.empty(2)) == (0, -1)
+    assert predict_mean(packed, data, np.array([0, 2, 4]), np.empty((2, 1))) == (0, -1)
     for offsets in ([0, 2, 5], [0, 3, 2], [-1, 2, 4]):   # the offset position of the problem
-        problem, position = predict_mean(packed, data, np.array(offsets), np.empty(2))
+        problem, position = predict_mean(packed, data, np.array(offsets), np.empty((2, 1)))
         assert problem == 6 and 0 <= position < 3
     bad = data.copy()
     bad[3] = [0.0, 0.0, 1.5]
-    assert predict_mean(packed, bad, np.array([0, 2, 4]), np.empty(2)) == (4, 3)
-    with pytest.raises(ValueError, match="out has 3 entries for 2 samples"):
-        predict_mean(packed, data, np.array([0, 2, 4]), np.empty(3))
+    assert predict_mean(packed, bad, np.array([0, 2, 4]), np.empty((2, 1))) == (4, 3)
+    with pytest.raises(ValueError, match=r"out has shape \(3, 1\); expected \(2, 1\)"):
+        predict_mean(packed, data, np.array([0, 2, 4]), np.empty((3, 1)))
     with pytest.raises(ValueError, match=r"expected \(2, 3\)"):
         apply_leaves(packed, data, np.array([0, 2, 4]), np.empty((2, 2), dtype=np.intp))
     with pytest.raises(ValueError, match="3 columns"):
-        predict_mean(packed, np.zeros((4, 2), np.float32), np.array([0, 4]), np.empty(1))
+        predict_mean(packed, np.zeros((4, 2), np.float32), np.array([0, 4]), np.empty((1, 1)))
     with pytest.raises(TypeError):
-        predict_mean(object(), data, np.array([0, 4]), np.empty(1))
+        predict_mean(object(), data, np.array([0, 4]), np.empty((1, 1)))
 
 
 def _build(sample_of, segment_ptr=(0, 3), n_samples=2):
     n = len(sample_of)
-    return build_tree(np.zeros(n, np.float32), np.zeros(n, np.float32), np.asarray(sample_of),
-                      list(segment_ptr), [-np.inf, np.inf], np.zeros(n_samples), np.ones(n_samples),
-                      np.zeros((1, 4), np.float32), False, False, "fixed", 1.0, 5, 2, -1, 1, 0)
+    objects = SimpleNamespace(x=np.zeros(n, np.float32), y=np.zeros(n, np.float32),
+                              sample_of=np.asarray(sample_of), segment_ptr=list(segment_ptr),
+                              band_edges=[-np.inf, np.inf], bounds=np.zeros((1, 4), np.float32),
+                              local_x=False, one_per_sample=False)
+    params = SimpleNamespace(test_type="fixed", test_width=1.0, n_tests=5, min_samples_split=2,
+                             max_depth=-1, max_retries=1)
+    return build_tree(objects, np.zeros(n_samples), np.ones(n_samples), params, 0)
 
 
 @pytest.mark.parametrize("sample_of, segment_ptr, match", [
@@ -174,7 +179,7 @@ def test_fuzz_edited_trees_are_packed_only_when_every_walk_stays_inside(forest, 
         return
     rng = np.random.default_rng(1)
     batch = ObjectSets.from_sequence(small_sets(rng, 20))
-    out = np.empty(len(batch))
+    out = np.empty((len(batch), 1))
     assert predict_mean(packed, batch.data, batch.offsets, out) == (0, -1)
     assert np.isfinite(out).all()
 
