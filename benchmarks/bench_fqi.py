@@ -28,6 +28,8 @@ from fqi import (FQI, RandomPolicy, evaluate, make_box_forest, make_grid_ridge,
                  train_dqn)
 
 ENV = "ObjectWorld-v0"
+REFERENCE_WORLDS = envs.reference_worlds(400)  # the thesis's 400 evaluation episodes of 50 steps
+N_WORLDS = 400  # training worlds in lockstep (the game's batched engine)
 PHASES = ("t_collect", "t_targets", "t_fit", "t_evaluate")
 FQI_RUNS = {
     "box": (lambda: make_box_forest(ENV), {}),
@@ -43,7 +45,8 @@ THESIS_LEVEL, HUMAN_LEVEL = 100_000, 150_000
 def run_fqi(name, iterations, samples, seed):
     """One FQI run; returns its summary with the per-iteration records."""
     make_regressor, params = FQI_RUNS[name]
-    agent = FQI(make_regressor(), ENV, samples_per_iteration=samples, seed=seed, **params)
+    agent = FQI(make_regressor(), ENV, samples_per_iteration=samples, n_envs=N_WORLDS,
+                eval_seeds=REFERENCE_WORLDS, seed=seed, **params)
     print(f"\n== {name}: {agent!r}")
     print(f"{'it':>3} {'reward':>10} {'samples':>8} {'nodes/tree':>10} "
           + " ".join(f"{p[2:]:>9}" for p in PHASES) + f" {'total':>7}")
@@ -68,7 +71,7 @@ def run_fqi(name, iterations, samples, seed):
 
 def run_dqn(steps, seed):
     print(f"\n== dqn: stable-baselines3 DQN on GridObservation(n_bins=10), {steps:,} steps")
-    result = train_dqn(ENV, total_timesteps=steps, seed=seed)
+    result = train_dqn(ENV, total_timesteps=steps, eval_seeds=REFERENCE_WORLDS, seed=seed)
     print(f"reward {result.reward:,.0f}  train {result.train_seconds:.1f}s  "
           f"evaluate {result.eval_seconds:.1f}s", flush=True)
     return {"name": "dqn", "kind": "dqn", "reward": result.reward,
@@ -121,8 +124,9 @@ def main():
         args.dqn_steps = args.dqn_steps or 2_000
     dqn_steps = args.dqn_steps or args.iterations * args.samples
 
-    anchors = {"random": evaluate(RandomPolicy(ENV, seed=0), ENV),
-               "greedy_heuristic": evaluate(envs.GreedyPolicy(envs.BatchedObjectWorld(1)), ENV)}
+    anchors = {"random": evaluate(RandomPolicy(ENV, seed=0), ENV, seeds=REFERENCE_WORLDS).total,
+               "greedy_heuristic": evaluate(envs.GreedyPolicy(envs.BatchedObjectWorld(1)), ENV,
+                                            seeds=REFERENCE_WORLDS).total}
     print(f"random policy {anchors['random']:,.0f}, greedy heuristic "
           f"{anchors['greedy_heuristic']:,.0f} (reward over 20,000 reference steps)")
     runs = [run_dqn(dqn_steps, args.seed) if name == "dqn"

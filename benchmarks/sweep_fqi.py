@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+import envs
 from fqi import FQI, make_box_forest
 
 ENV = "ObjectWorld-v0"
@@ -53,7 +54,8 @@ def main():
         for seed in args.seeds:
             start = time.perf_counter()
             agent = FQI(make_box_forest(ENV, n_estimators=args.trees), ENV,
-                        samples_per_iteration=args.samples, seed=seed, **settings(value))
+                        samples_per_iteration=args.samples, n_envs=400,
+                        eval_seeds=envs.reference_worlds(400), seed=seed, **settings(value))
             curve = [r["reward"] for r in agent.learn(args.iterations).history]
             seconds = time.perf_counter() - start
             last = float(np.mean(curve[-5:]))

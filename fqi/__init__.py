@@ -1,17 +1,22 @@
-"""Fitted Q-iteration on the ObjectWorld game, stable-baselines3 style, plus baselines.
+"""Fitted Q-iteration for any gymnasium env with discrete actions, stable-baselines3 style,
+plus the baselines of the thesis.
 
-- `FQI`: the agent (``learn``, ``predict``, ``save`` / ``load``, a CSV log);
-- `evaluate`: total greedy reward over 20,000 steps on the fixed reference worlds, for any
-  policy with a ``predict`` method (`RandomPolicy`, `envs.GreedyPolicy`, DQN, `FQI`);
+- `FQI`: the agent (``learn``, ``predict``, ``save`` / ``load``, a CSV log), on ``Box``
+  observations (a feature matrix: any scikit-learn regressor) or object sets
+  (``Sequence(Box(shape=(3,)))``: `boxtrees.BoxExtraTreesRegressor`);
+- `evaluate`: one greedy episode per fixed reset seed, total and mean return, for any policy
+  with a ``predict`` method (`RandomPolicy`, DQN, `FQI`);
 - baselines: `make_box_forest` (thesis parameters; ``test_type="classic"``),
   `make_grid_ridge` (``GridCounts`` + ``Ridge``), `GridObservation` (a fixed-size
   observation wrapper) and `train_dqn` (stable-baselines3 DQN on it).
+
+`fqi` talks to its env through gymnasium's API only and knows no particular game.
 """
 from ._agent import FQI
 from ._baselines import DQNResult, make_box_forest, make_grid_ridge, train_dqn
-from ._evaluate import RandomPolicy, evaluate
+from ._evaluate import Evaluation, RandomPolicy, evaluate
 from ._logger import CSVLogger
 from ._wrappers import GridObservation
 
-__all__ = ["FQI", "evaluate", "RandomPolicy", "GridObservation", "make_box_forest",
-           "make_grid_ridge", "train_dqn", "DQNResult", "CSVLogger"]
+__all__ = ["FQI", "evaluate", "Evaluation", "RandomPolicy", "GridObservation",
+           "make_box_forest", "make_grid_ridge", "train_dqn", "DQNResult", "CSVLogger"]

@@ -1,78 +1,85 @@
-"""`FQI`: fitted Q-iteration with one scikit-learn regressor per action."""
-import dataclasses
-import os
-import pickle
+"""`FQI`: fitted Q-iteration with one scikit-learn regressor per action, on any gymnasium env."""
+import inspect
 import time
 import warnings
 from concurrent.futures import ThreadPoolExecutor
-from numbers import Integral
 
-import joblib
 import numpy as np
+from gymnasium.vector import VectorEnv
 from joblib import effective_n_jobs
 from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 from tqdm.auto import tqdm
 
-from envs import WorldRules
-
+from ._callbacks import _as_callback
 from ._checks import (_check_bool, _check_int, _check_n_jobs, _check_real, _check_seed,
-                      _check_steps)
-from ._collect import _Collector, _Transitions
-from ._evaluate import evaluate
+                      _check_verbose)
+from ._collect import _checked_step, _Collector, _Transitions
+from ._envs import _check_env, _copy_vector, _make_vector, _n_actions
+from ._evaluate import _eval_seeds, evaluate
 from ._logger import CSVLogger
-from ._observations import _observation_batch
-from ._worlds import _world_rules
+from ._observations import _ObjectRows, _observation_format
+from ._saving import _read_save, _write_save
 
 __all__ = ["FQI"]
 
-_SAVE_FORMAT = 1
-_SAVE_KEYS = frozenset({"format", "params", "rules", "q_functions_", "history",
-                        "num_timesteps", "iteration", "rngs"})
+_DEFAULT_ENVS = 16
+# What `save` leaves out (SB3 saves its __dict__ minus such a list): the envs, which hold
+# simulators, the transitions, the threads and the open log.
+_UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_pool", "_data", "logger"})
+# What a save holds beyond the constructor parameters.
+_LEARNED = ("q_functions_", "history", "num_timesteps", "iteration", "observation_space",
+            "action_space")
 
 
 class FQI:
-    """Fitted Q-iteration (Ernst et al. 2005) in the data regimes of Blank (2015), 3.2.2.
+    """Fitted Q-iteration (Ernst et al. 2005) on any gymnasium env with discrete actions,
+    in the data regimes of Blank (2015), 3.2.2.
 
     The Q-function is one regressor per action, each a fresh `sklearn.base.clone` of
     `regressor` fitted at every iteration; the agent only calls ``fit(X, y)`` and
-    ``predict(X)``, with ``X`` a `boxtrees.ObjectSets` of observations (object sets), so
-    any regressor that accepts object sets plugs in (`boxtrees.BoxExtraTreesRegressor`, a
-    pipeline starting with `boxtrees.GridCounts`, ...).
+    ``predict(X)``. ``X`` follows the env's observation space: for a ``Box``, a 2D float
+    matrix with one flattened observation per row, so any scikit-learn regressor plugs in;
+    for ``Sequence(Box(shape=(3,)))`` (sets of ``[x, y, type]`` objects), one
+    `boxtrees.ObjectSets` (``data`` + ``offsets``) per batch, which
+    `boxtrees.BoxExtraTreesRegressor` or a pipeline starting with `boxtrees.GridCounts` take.
 
     Iteration ``n`` of `learn`:
 
     1. *collect* (iteration 0, then every `resample_every` iterations):
-       `samples_per_iteration` transitions from `n_worlds` training worlds played in
-       lockstep, with the uniform random policy at iteration 0 and the epsilon-greedy
-       policy of ``Q_{n-1}`` later. They replace the data set, or with `keep_data` are
-       appended to it (oldest dropped beyond `max_samples`);
+       `samples_per_iteration` transitions from the `n_envs` envs of a gymnasium vector env,
+       with the uniform random policy at iteration 0 and the epsilon-greedy policy of
+       ``Q_{n-1}`` later. They replace the data set, or with `keep_data` are appended to it
+       (oldest dropped beyond `max_samples`);
     2. *targets*: ``r`` at iteration 0, then ``r + gamma * max_a Q_{n-1}(s', a)`` for every
-       transition in the data set (no bootstrap after a real termination; the 50-step time
-       limit is a truncation, not a termination, and is bootstrapped through);
+       transition in the data set (no bootstrap after a termination; a truncation, such as
+       a time limit, is bootstrapped through with the true final observation);
     3. *fit* ``Q_n``: one clone of `regressor` per action on the transitions with that
        action;
-    4. *evaluate*: greedy play over `eval_steps` steps on the fixed reference worlds
-       (`fqi.evaluate`), logged with the time of each phase.
+    4. *evaluate*: greedy play, one episode per seed of `eval_seeds` (`fqi.evaluate`),
+       logged with the time of each phase.
 
     Parameters
     ----------
     regressor : scikit-learn regressor
         Template of the per-action Q-functions; must have ``fit`` and ``predict``, be
-        clonable and take object sets (else a TypeError or ValueError at its first fit),
-        and predict one finite value per observation (else a ValueError naming the action
-        and the iteration). A ``random_state`` parameter (also nested,
-        ``step__random_state``) is set from `seed` on each clone. For
-        `boxtrees.BoxExtraTreesRegressor`, set ``n_jobs=-1`` to use every core and
-        ``view_bounds=env view`` to draw tests in the view square (`fqi.make_box_forest`
-        does both).
-    env : str, gymnasium.Env, envs.BatchedObjectWorld or envs.WorldRules
-        The ObjectWorld variant: an id such as ``"ObjectWorld-v0"`` or an env instance
-        (wrappers allowed) whose rules (``env.unwrapped.rules``) build the batched rollout
-        and evaluation worlds. The action space must be `gymnasium.spaces.Discrete`.
+        clonable, and predict one finite value per observation (checked here by fitting a
+        clone on the env's first observations, and after every fit). A ``random_state``
+        parameter (also nested, ``step__random_state``) is set from `seed` on each clone.
+        For `boxtrees.BoxExtraTreesRegressor`, `fqi.make_box_forest` reads the view square
+        from the observation space and uses every core.
+    env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable
+        The environment; its action space must be ``Discrete`` (numbered from 0) and its
+        observation space a ``Box`` or ``Sequence(Box(shape=(3,)))``. A registered id is made
+        with ``gymnasium.make_vec(id, num_envs=n_envs)``, which uses the id's
+        ``vector_entry_point`` (a batched engine) when it has one and a ``SyncVectorEnv``
+        otherwise; an env made by ``gymnasium.make`` is rebuilt the same way from its spec;
+        any other env is copied `n_envs` times (``copy.deepcopy``); a callable is called
+        once per env; a vector env is used as it is. The env is tried once here (a reset
+        and a step): an env that raises gives a RuntimeError naming the call.
     gamma : float, default=0.5
-        Discount factor in ``[0, 1)``. 0.5 scored best and most steadily in a measured
-        comparison of 0.5, 0.8, 0.9 and 0.95 (README, section "fqi").
+        Discount factor in ``[0, 1)``. 0.5 scored best on ObjectWorld (README, "fqi");
+        control tasks with long horizons need more (0.99 on CartPole).
     epsilon : float, default=0.2
         Probability of a uniform random action while collecting (thesis: 0.2).
     samples_per_iteration : int, default=20_000
@@ -86,11 +93,20 @@ class FQI:
         crashes).
     max_samples : int, default=100_000
         Cap on the data set size when `keep_data` is True.
-    n_worlds : int, default=400
-        Training worlds played in lockstep while collecting.
-    eval_steps : int, default=20_000
-        Steps of the greedy evaluation after each iteration (a multiple of the episode
-        length, 50); 0 skips the evaluation (``reward`` is then NaN).
+    n_envs : int, default=None
+        Envs played side by side while collecting; None: the vector env's own number, or
+        16 for any other env form.
+    eval_episodes : int, default=None
+        Evaluation episodes after each iteration: ``len(eval_seeds)`` when those are given,
+        else 10; 0 skips the evaluation (``reward`` is then NaN), whatever `eval_seeds`.
+    eval_seeds : sequence of int, default=None
+        Reset seed of each evaluation episode, fixed for the whole run. Default
+        ``2**40, 2**40 + 1, ...``: training draws its reset seeds below ``2**40``, so those
+        episodes are never trained on.
+    eval_env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable, default=None
+        Env to evaluate on (same observation and action spaces); default: built from `env`
+        like the training env, one env per episode (a vector env `env` is rebuilt from its
+        spec; one without a spec needs `eval_env` or ``eval_episodes=0``).
     n_jobs : int, default=-1
         Threads predicting the per-action Q-functions concurrently (at most one per
         action; -1: one per core). The box forests release the GIL while predicting.
@@ -98,8 +114,9 @@ class FQI:
         CSV file receiving one row per iteration (see `history` for the columns); its
         directory must exist and be writable (checked here, see `CSVLogger`).
     seed : int or None, default=None
-        Drives the training worlds, the exploration and the regressors' random states: the
-        same seed gives the same reward curve.
+        Drives the training resets, the exploration and the regressors' random states: on
+        an env that is deterministic given its reset seeds, the same seed gives the same
+        reward curve.
     verbose : int or bool, default=0
         1 (or True) prints one line per iteration.
 
@@ -108,73 +125,176 @@ class FQI:
     q_functions_ : list of regressors
         The fitted ``Q_n``, one per action.
     history : list of dict
-        One record per iteration: ``iteration``, ``reward`` (evaluation), ``n_samples``
-        (data set size), ``new_samples``, ``num_timesteps``, ``collect_reward_per_step``,
-        ``nodes_per_tree`` (mean over actions and trees; NaN without trees) and the seconds
-        of each phase: ``t_collect``, ``t_targets``, ``t_fit``, ``t_evaluate``, ``t_total``.
+        One record per iteration: ``iteration``, ``reward`` (total return of the evaluation
+        episodes), ``mean_return`` (per episode), ``n_samples`` (data set size),
+        ``new_samples``, ``num_timesteps``, ``collect_reward_per_step``, ``nodes_per_tree``
+        (mean over actions and trees; NaN without trees) and the seconds of each phase:
+        ``t_collect``, ``t_targets``, ``t_fit``, ``t_evaluate``, ``t_total``.
     num_timesteps : int
-        Environment steps collected so far (all worlds).
+        Environment steps collected so far (transitions, over all envs; the reset steps of
+        gymnasium's next-step autoreset are not transitions and not counted).
     iteration : int
         Iterations done so far.
-    rules : envs.WorldRules
+    observation_space, action_space : gymnasium.spaces.Space
+        Of one env.
     n_actions : int
 
     Examples
     --------
-    >>> from boxtrees import BoxExtraTreesRegressor
+    >>> from sklearn.ensemble import ExtraTreesRegressor
     >>> from fqi import FQI
-    >>> forest = BoxExtraTreesRegressor(n_estimators=5, n_tests=50, view_bounds=10)
-    >>> agent = FQI(forest, "ObjectWorld-v0", samples_per_iteration=2000, n_worlds=100,
-    ...             eval_steps=1000, seed=0).learn(2)
-    >>> [r["iteration"] for r in agent.history]
+    >>> agent = FQI(ExtraTreesRegressor(n_estimators=10, random_state=0), "CartPole-v1",
+    ...             gamma=0.99, samples_per_iteration=1000, eval_episodes=2, seed=0)
+    >>> [r["iteration"] for r in agent.learn(2).history]
     [0, 1]
+    >>> agent.predict(agent.observation_space.sample())[0] in (0, 1)
+    True
     """
 
     def __init__(self, regressor, env, gamma=0.5, epsilon=0.2, samples_per_iteration=20_000,
-                 resample_every=1, keep_data=False, max_samples=100_000, n_worlds=400,
-                 eval_steps=20_000, n_jobs=-1, log_path=None, seed=None, verbose=0):
+                 resample_every=1, keep_data=False, max_samples=100_000, n_envs=None,
+                 eval_episodes=None, eval_seeds=None, eval_env=None, n_jobs=-1,
+                 log_path=None, seed=None, verbose=0):
+        self._set_params({name: value for name, value in locals().items() if name != "self"})
+        world_seq, action_seq, fit_seq = np.random.SeedSequence(self.seed).spawn(3)
+        self._world_rng = np.random.default_rng(world_seq)
+        self._action_rng = np.random.default_rng(action_seq)
+        self._fit_rng = np.random.default_rng(fit_seq)
+        self.observation_space = self.action_space = None
+        self.q_functions_ = None
+        self._q_iteration = None  # the iteration that fitted q_functions_
+        self.history = []
+        self.num_timesteps = 0
+        self.iteration = 0
+        self.set_env(env)
+
+    @classmethod
+    def _param_names(cls):
+        return [name for name in inspect.signature(cls.__init__).parameters if name != "self"]
+
+    def _set_params(self, params):
+        """Check the constructor parameters (all but the envs, see `set_env`) and set them
+        as attributes of the same names."""
+        regressor = params["regressor"]
         for method in ("fit", "predict"):
             if not callable(getattr(regressor, method, None)):
                 raise TypeError(f"regressor must have fit and predict methods; "
                                 f"{type(regressor).__name__} has no {method}")
         clone(regressor)  # a clear TypeError now rather than at the first fit
         self.regressor = regressor
-        self.rules = _world_rules(env)
-        self.n_actions = self.rules.n_actions
-        self.gamma = _check_real("gamma", gamma, 0.0, 1.0, high_inclusive=False)
-        self.epsilon = _check_real("epsilon", epsilon, 0.0, 1.0)
-        self.samples_per_iteration = _check_int("samples_per_iteration", samples_per_iteration, 1)
+        self.env, self.eval_env = params["env"], params["eval_env"]
+        if self.eval_env is not None:
+            _check_env(self.eval_env, "eval_env")
+        self.gamma = _check_real("gamma", params["gamma"], 0.0, 1.0, high_inclusive=False)
+        self.epsilon = _check_real("epsilon", params["epsilon"], 0.0, 1.0)
+        self.samples_per_iteration = _check_int("samples_per_iteration",
+                                                params["samples_per_iteration"], 1)
+        resample_every = params["resample_every"]
         self.resample_every = (None if resample_every is None
                                else _check_int("resample_every", resample_every, 1))
-        self.keep_data = _check_bool("keep_data", keep_data)
-        self.max_samples = _check_int("max_samples", max_samples, 1)
+        self.keep_data = _check_bool("keep_data", params["keep_data"])
+        self.max_samples = _check_int("max_samples", params["max_samples"], 1)
         if self.keep_data and self.max_samples < self.samples_per_iteration:
             raise ValueError(f"max_samples ({self.max_samples}) must be at least "
                              f"samples_per_iteration ({self.samples_per_iteration})")
-        self.n_worlds = _check_int("n_worlds", n_worlds, 1)
-        self.eval_steps = _check_steps("eval_steps", eval_steps, self.rules.max_steps,
-                                       allow_zero=True)
-        self.n_jobs = _check_n_jobs(n_jobs)
-        self.seed = _check_seed("seed", seed)
-        if not isinstance(verbose, (Integral, np.bool_)):
-            raise TypeError(f"verbose must be an int or a bool, got {verbose!r}")
-        if verbose < 0:
-            raise ValueError(f"verbose must be >= 0, got {verbose}")
-        self.verbose = int(verbose)
-        self.log_path = log_path
-        self.logger = None if log_path is None else CSVLogger(log_path)
-        world_seq, action_seq, fit_seq = np.random.SeedSequence(seed).spawn(3)
-        self._world_rng = np.random.default_rng(world_seq)
-        self._action_rng = np.random.default_rng(action_seq)
-        self._fit_rng = np.random.default_rng(fit_seq)
-        self._collector = None
+        n_envs = params["n_envs"]
+        self.n_envs = None if n_envs is None else _check_int("n_envs", n_envs, 1)
+        self.eval_episodes, self.eval_seeds = params["eval_episodes"], params["eval_seeds"]
+        self._eval_seeds = _eval_seeds(self.eval_episodes, self.eval_seeds, "eval_episodes",
+                                       "eval_seeds")
+        self.n_jobs = _check_n_jobs(params["n_jobs"])
+        self.seed = _check_seed("seed", params["seed"])
+        self.verbose = _check_verbose(params["verbose"])
+        self.log_path = params["log_path"]
+        self.logger = None if self.log_path is None else CSVLogger(self.log_path)
         self._pool = None
+
+    # ------------------------------------------------------------------ envs
+    def set_env(self, env, eval_env=None):
+        """Play on `env` from now on (its spaces must be the agent's, once it has some).
+
+        Builds the training vector env and the evaluation one (from `eval_env`, else from
+        the constructor's `eval_env`, else from `env`), then tries the env (a reset and a
+        step) and the regressor (fitted on those observations). Collection starts new
+        episodes.
+
+        Parameters
+        ----------
+        env, eval_env
+            As in the constructor.
+        """
+        _check_env(env)
+        if eval_env is not None:
+            _check_env(eval_env, "eval_env")
+            self.eval_env = eval_env
+        vector = _make_vector(env, self.n_envs or _DEFAULT_ENVS)
+        if isinstance(env, VectorEnv) and self.n_envs not in (None, vector.num_envs):
+            raise ValueError(f"n_envs={self.n_envs} but the vector env has {vector.num_envs} "
+                             f"envs; leave n_envs out (None) for a vector env")
+        observation_space = vector.single_observation_space
+        action_space = vector.single_action_space
+        n_actions = _n_actions(action_space)
+        observations = _observation_format(observation_space)
+        if self.observation_space is not None and (observation_space, action_space) != (
+                self.observation_space, self.action_space):
+            raise ValueError(f"env has the spaces {observation_space} and {action_space}; "
+                             f"the agent was made for {self.observation_space} and "
+                             f"{self.action_space}")
+        eval_vector = self._evaluation_env(env, vector, (observation_space, action_space))
+        first = _tried(vector, observations)
+        self._check_regressor(observations, first)
+        self.env = env
+        self._env, self._eval_env = vector, eval_vector
+        self.observation_space, self.action_space = observation_space, action_space
+        self.n_actions, self._observations = n_actions, observations
+        self._collector = None
         self._data = None
-        self.q_functions_ = None
-        self._q_iteration = None  # the iteration that fitted q_functions_
-        self.history = []
-        self.num_timesteps = 0
-        self.iteration = 0
+
+    def _evaluation_env(self, env, vector, spaces):
+        """The vector env of the evaluation after each iteration (None without one)."""
+        n = len(self._eval_seeds)
+        if n == 0:
+            return None
+        if self.eval_env is not None:
+            evaluation = _make_vector(self.eval_env, n)
+            found = (evaluation.single_observation_space, evaluation.single_action_space)
+            if found != spaces:
+                raise ValueError(f"eval_env has the spaces {found[0]} and {found[1]}; env "
+                                 f"has {spaces[0]} and {spaces[1]}")
+            return evaluation
+        if isinstance(env, VectorEnv):
+            evaluation = _copy_vector(vector, n)
+            if evaluation is None:
+                raise ValueError("a vector env without a spec cannot be rebuilt for the "
+                                 "evaluation after each iteration: give eval_env, or "
+                                 "eval_episodes=0 (and evaluate with fqi.evaluate)")
+            return evaluation
+        return _make_vector(env, n)
+
+    def _check_regressor(self, observations, batch):
+        """Fit a clone of the regressor on `batch` (zero targets) and check its predictions,
+        so that a regressor that cannot take these observations fails now."""
+        model = clone(self.regressor)
+        try:
+            prediction = model.fit(batch, np.zeros(len(batch))).predict(batch)
+        except (TypeError, ValueError) as exc:
+            hint = ""
+            if isinstance(observations, _ObjectRows):
+                hint = ("; use a regressor that takes object sets, such as "
+                        "boxtrees.BoxExtraTreesRegressor (fqi.make_box_forest), or wrap a "
+                        "feature-vector regressor in a pipeline starting with "
+                        "boxtrees.GridCounts (fqi.make_grid_ridge)")
+            error = ValueError if isinstance(exc, ValueError) else TypeError
+            raise error(f"{self.regressor!r} failed to fit and predict the env's "
+                        f"observations, which FQI gives it as {observations.what} "
+                        f"({type(exc).__name__}: {exc}){hint}") from exc
+        _checked_prediction(prediction, len(batch),
+                            lambda: f"{self.regressor!r}, fitted on the env's first "
+                                    f"observations,")
+
+    def get_env(self):
+        """The training vector env (None for an agent loaded without an env)."""
+        return self._env
 
     # ------------------------------------------------------------------ training
     def learn(self, n_iterations, callback=None, progress_bar=False):
@@ -183,12 +303,15 @@ class FQI:
         Parameters
         ----------
         n_iterations : int
-        callback : callable or object, default=None
-            Called after every iteration, either as ``callback(locals_, globals_)`` (the
-            stable-baselines3 convention: ``locals_["self"]`` is the agent and
-            ``locals_["record"]`` the iteration's record) or, for an object with an
-            ``on_iteration`` method, as ``callback.on_iteration(agent, record)``. Returning
-            False stops training (any other value, None included, continues).
+        callback : callable, BaseCallback or list, default=None
+            Called after every iteration. A stable-baselines3 ``BaseCallback`` or
+            ``CallbackList`` is taken as it is, with the agent as its ``model``:
+            ``init_callback`` and ``on_training_start(locals_, globals_)`` before the first
+            iteration, ``update_locals`` and ``on_step()`` after each (``self.locals["record"]``
+            is the iteration's record), ``on_training_end()`` at the end. A plain
+            ``callback(locals_, globals_)`` is called after each iteration
+            (``locals_["self"]`` is the agent, ``locals_["record"]`` the record). A list
+            calls each in turn. A False return stops training (None continues).
         progress_bar : bool, default=False
             Show a tqdm bar over the iterations, with the last evaluation reward.
 
@@ -197,17 +320,24 @@ class FQI:
         self : FQI
         """
         n_iterations = _check_int("n_iterations", n_iterations, 1)
-        notify = _callback_function(callback)
+        callback = _as_callback(callback)
         progress_bar = _check_bool("progress_bar", progress_bar)
+        if self._env is None:
+            raise ValueError("this agent has no env (it was loaded without one): pass env to "
+                             "FQI.load or call set_env(env)")
         if self._collector is None:
-            self._collector = _Collector(self.rules, self.n_worlds, self._world_rng)
+            self._collector = _Collector(self._env, self._observations, self._world_rng)
+        callback.init_callback(self)
+        callback.on_training_start(locals(), globals())
         with tqdm(total=n_iterations, desc="FQI", disable=not progress_bar) as bar:
             for _ in range(n_iterations):
                 record = self._iterate()
                 bar.set_postfix(reward=f"{record['reward']:,.0f}")
                 bar.update()
-                if notify is not None and notify(locals(), globals()) is False:
+                callback.update_locals(locals())
+                if callback.on_step() is False:
                     break
+        callback.on_training_end()
         return self
 
     def _iterate(self):
@@ -217,13 +347,20 @@ class FQI:
         collect_reward = np.nan
         if self._data is None or (self.resample_every is not None
                                   and self.iteration % self.resample_every == 0):
-            batch = self._collector.collect(
-                self.samples_per_iteration, self._behaviour,
-                None if self.q_functions_ is None else self._q_values)
-            self.num_timesteps += -(-self.samples_per_iteration // self.n_worlds) * self.n_worlds
+            try:
+                batch, n_steps = self._collector.collect(
+                    self.samples_per_iteration, self._behaviour,
+                    None if self.q_functions_ is None else self._q_values)
+            except Exception as exc:
+                exc.add_note(f"(while FQI collected the transitions of iteration "
+                             f"{self.iteration} on {self._env})")
+                raise
+            self.num_timesteps += n_steps
             new, collect_reward = len(batch), float(batch.rewards.mean())
             if self.keep_data and self._data is not None:
-                batch = _Transitions.concatenate([self._data, batch])[-self.max_samples:]
+                batch = _Transitions.concatenate([self._data, batch],
+                                                 self._observations.concatenate)
+                batch = batch[-self.max_samples:]
             self._data = batch
         data = self._data
         collected = time.perf_counter()
@@ -241,12 +378,14 @@ class FQI:
         self._q_iteration = self.iteration
         fitted = time.perf_counter()
 
-        reward = evaluate(self, self.rules, self.eval_steps) if self.eval_steps else np.nan
+        result = (evaluate(self, self._eval_env, seeds=self._eval_seeds)
+                  if self._eval_seeds else None)
         done = time.perf_counter()
 
         record = {
-            "iteration": self.iteration, "reward": reward, "n_samples": len(data),
-            "new_samples": new, "num_timesteps": self.num_timesteps,
+            "iteration": self.iteration, "reward": np.nan if result is None else result.total,
+            "mean_return": np.nan if result is None else result.mean,
+            "n_samples": len(data), "new_samples": new, "num_timesteps": self.num_timesteps,
             "collect_reward_per_step": collect_reward,
             "nodes_per_tree": _nodes_per_tree(self.q_functions_),
             "t_collect": collected - start, "t_targets": targeted - collected,
@@ -257,7 +396,7 @@ class FQI:
         if self.logger is not None:
             self.logger.write(record)
         if self.verbose:
-            print(f"iteration {record['iteration']:3d}  reward {reward:>12,.0f}  "
+            print(f"iteration {record['iteration']:3d}  reward {record['reward']:>12,.0f}  "
                   f"samples {len(data):>7,d}  collect {record['t_collect']:5.2f}s  "
                   f"targets {record['t_targets']:5.2f}s  fit {record['t_fit']:5.2f}s  "
                   f"evaluate {record['t_evaluate']:5.2f}s")
@@ -277,12 +416,7 @@ class FQI:
                         q.argmax(axis=1))
 
     def _fit_action(self, action, data, targets):
-        """A clone of the regressor fitted on the transitions with `action`.
-
-        A TypeError or ValueError of the agent's first fit is re-raised saying what the
-        regressor was given (object sets) and how to wrap a feature-vector regressor. Only
-        fitting tells whether a regressor takes object sets, so the constructor cannot.
-        """
+        """A clone of the regressor fitted on the transitions with `action`."""
         mask = data.actions == action
         if not mask.any():
             if self.q_functions_ is None:
@@ -296,20 +430,7 @@ class FQI:
         params = model.get_params()
         model.set_params(**{k: seed for k in params
                             if k == "random_state" or k.endswith("__random_state")})
-        try:
-            return model.fit(data.states[mask], targets[mask])
-        except (TypeError, ValueError) as exc:
-            if self.q_functions_ is not None or action > 0:
-                raise  # the regressor has taken object sets before
-            error = ValueError if isinstance(exc, ValueError) else TypeError
-            raise error(
-                f"{self.regressor!r} failed on its first fit, given object sets as a "
-                f"boxtrees.ObjectSets ({type(exc).__name__}: {exc}). FQI gives every "
-                f"regressor its observations as object sets (variable-size sets of "
-                f"[dx, dy, type] rows), not as a feature matrix: use a regressor that takes "
-                f"object sets, such as boxtrees.BoxExtraTreesRegressor (fqi.make_box_forest), "
-                f"or wrap a feature-vector regressor in a pipeline starting with "
-                f"boxtrees.GridCounts (fqi.make_grid_ridge)") from exc
+        return model.fit(data.states[mask], targets[mask])
 
     # ------------------------------------------------------------------ acting
     def q_values(self, observation):
@@ -324,36 +445,22 @@ class FQI:
         -------
         q : ndarray of shape (n_actions,) for one observation, (n, n_actions) for a batch
         """
-        sets, single = _observation_batch(observation)
-        q = self._q_values(sets)
+        batch, single = self._observations.as_input(observation)
+        q = self._q_values(batch)
         return q[0] if single else q
 
-    def _q_values(self, sets):
+    def _q_values(self, batch):
         if self.q_functions_ is None:
             raise NotFittedError("this FQI agent has no Q-function yet; call learn() first")
         if self._pool is None:
             self._pool = ThreadPoolExecutor(min(effective_n_jobs(self.n_jobs), self.n_actions))
-        predictions = self._pool.map(lambda model: model.predict(sets), self.q_functions_)
-        q = np.empty((len(sets), self.n_actions))
+        predictions = self._pool.map(lambda model: model.predict(batch), self.q_functions_)
+        q = np.empty((len(batch), self.n_actions))
         for action, prediction in enumerate(predictions):
-            q[:, action] = self._checked_prediction(action, prediction, len(sets))
+            q[:, action] = _checked_prediction(
+                prediction, len(batch), lambda: f"iteration {self._q_iteration}'s Q-function "
+                f"of action {action} ({self.q_functions_[action]!r})")
         return q
-
-    def _checked_prediction(self, action, prediction, n):
-        """`prediction` of the Q-function of `action` for `n` observations, as floats of
-        shape ``(n,)``, after checking there are `n` of them and all are finite."""
-        prediction = np.asarray(prediction, dtype=np.float64)
-        bad = ~np.isfinite(prediction)
-        if prediction.size == n and not bad.any():
-            return prediction.reshape(n)
-        model = (f"iteration {self._q_iteration}'s Q-function of action {action} "
-                 f"({self.q_functions_[action]!r})")
-        if prediction.size != n:
-            raise ValueError(f"{model} predicted an array of size {prediction.size} for "
-                             f"{n} observations; a regressor must predict one value per "
-                             f"observation")
-        raise ValueError(f"{model} predicted non-finite Q-values (NaN or inf) for {bad.sum()} "
-                         f"of {n} observations; a regressor must predict finite values")
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         """Actions for one observation or a batch (the stable-baselines3 signature).
@@ -361,11 +468,12 @@ class FQI:
         Parameters
         ----------
         observation : array-like or batch
-            One world's objects, an ``(n, 3)`` array of rows ``[dx, dy, type]``; a batch:
-            an `envs.RaggedBatch` / `boxtrees.ObjectSets` (anything with ``data`` and
-            ``offsets``), a list of ``(n_i, 3)`` arrays or an ``(batch, n, 3)`` array; or
-            observations padded by `envs.PaddedObjects`: ``(max_objects, 4)`` or
-            ``(batch, max_objects, 4)``.
+            For a ``Box`` space: one observation of its shape, or a batch
+            ``(batch, *shape)``. For object sets: one ``(n, 3)`` array of rows
+            ``[x, y, type]``; a batch: anything with ``data`` and ``offsets`` (a
+            `boxtrees.ObjectSets`, a batched engine's observations), a list of ``(n_i, 3)``
+            arrays or a ``(batch, n, 3)`` array; or padded rows ``[x, y, type, valid]``
+            (``envs.PaddedObjects``): ``(max_objects, 4)`` or ``(batch, max_objects, 4)``.
         state, episode_start
             Unused (the policy is reactive); accepted for stable-baselines3.
         deterministic : bool, default=True
@@ -376,32 +484,30 @@ class FQI:
         actions : int, or ndarray of int of shape (batch,)
         state : None
         """
-        sets, single = _observation_batch(observation)
-        q = self._q_values(sets)
+        batch, single = self._observations.as_input(observation)
+        q = self._q_values(batch)
         actions = q.argmax(axis=1) if deterministic else self._epsilon_greedy(q)
         return (actions[0] if single else actions), None
 
     # ------------------------------------------------------------------ persistence
     def save(self, path):
-        """Save the parameters, the fitted Q-functions, the history and the random
-        streams with joblib (the transitions are not saved).
+        """Save the agent with joblib: its attributes (every constructor parameter, the
+        fitted Q-functions, the history, the spaces and the random streams), less the envs,
+        the transitions, the threads and the open log. An env given by its id is saved as
+        the id; any other env is not saved.
 
         Parameters
         ----------
         path : str or path-like
         """
-        params = {name: getattr(self, name) for name in (
-            "regressor", "gamma", "epsilon", "samples_per_iteration", "resample_every",
-            "keep_data", "max_samples", "n_worlds", "eval_steps", "n_jobs", "seed", "verbose")}
-        joblib.dump({
-            "format": _SAVE_FORMAT, "params": params, "rules": dataclasses.asdict(self.rules),
-            "q_functions_": self.q_functions_, "history": self.history,
-            "num_timesteps": self.num_timesteps, "iteration": self.iteration,
-            "rngs": (self._world_rng, self._action_rng, self._fit_rng),
-        }, path)
+        state = {k: v for k, v in self.__dict__.items() if k not in _UNSAVED}
+        for name in ("env", "eval_env"):
+            if not isinstance(state[name], str):
+                state[name] = None
+        _write_save(state, path)
 
     @classmethod
-    def load(cls, path, env=None, log_path=None):
+    def load(cls, path, env=None, **params):
         """Load an agent saved by `save`.
 
         Loading unpickles the file, which can run arbitrary code: load only trusted files.
@@ -412,28 +518,32 @@ class FQI:
             A file written by `save`; ValueError for any other file (empty, truncated,
             damaged, not an FQI save, or a save of another format version), and
             FileNotFoundError for a missing one.
-        env : str, gymnasium.Env or envs.WorldRules, default=None
-            Play and train on this env instead of the saved rules (same number of actions).
-        log_path : str or path-like, default=None
-            CSV log for further `learn` calls.
+        env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable, default=None
+            Play and train on this env (same spaces as the saved agent). Default: the saved
+            id, if the agent was made from one; otherwise the agent has no env: it predicts,
+            and learns after `set_env`.
+        **params
+            Constructor parameters to change (``log_path``, ``n_jobs``, ``eval_seeds``...),
+            checked as by the constructor; the others keep their saved values.
 
         Returns
         -------
         agent : FQI
             Further `learn` calls continue the iteration count with freshly collected data.
         """
-        state = _read_save(path)
-        rules = WorldRules(**state["rules"])
-        agent = cls(env=rules if env is None else env, log_path=log_path, **state["params"])
-        if agent.n_actions != rules.n_actions:
-            raise ValueError(f"env has {agent.n_actions} actions, the saved agent "
-                             f"{rules.n_actions}")
-        agent.q_functions_ = state["q_functions_"]
-        agent.history = state["history"]
-        agent.num_timesteps = state["num_timesteps"]
-        agent.iteration = state["iteration"]
-        agent._q_iteration = agent.iteration - 1
-        agent._world_rng, agent._action_rng, agent._fit_rng = state["rngs"]
+        names = cls._param_names()
+        unknown = sorted(set(params) - set(names))
+        if unknown:
+            raise TypeError(f"FQI.load got unknown parameters {unknown}; the constructor "
+                            f"parameters are {names}")
+        state = _read_save(path, required=[*names, *_LEARNED])
+        agent = cls.__new__(cls)
+        agent.__dict__.update({k: v for k, v in state.items() if k not in names})
+        agent._set_params({**{name: state[name] for name in names}, **params})
+        agent._env = agent._eval_env = agent._collector = agent._data = None
+        env = agent.env if env is None else env
+        if env is not None:
+            agent.set_env(env)
         return agent
 
     def __getstate__(self):
@@ -448,44 +558,40 @@ class FQI:
                 f"iteration={self.iteration})")
 
 
-def _read_save(path):
-    """The state that `FQI.save` wrote to `path`, or a ValueError saying why the file is
-    not one (FileNotFoundError when it does not exist)."""
-    path = os.fspath(path)
-    with open(path, "rb") as f:
-        head = f.read(1)
-    if not head:
-        raise ValueError(f"{path} is empty, not an agent saved by FQI.save")
-    if head != pickle.PROTO:  # FQI.save writes an uncompressed joblib pickle
-        raise ValueError(f"{path} is not an agent saved by FQI.save (not a joblib pickle)")
-    try:
-        state = joblib.load(path)
-    except Exception as exc:  # unpickling damaged data can raise almost anything
-        raise ValueError(f"{path} could not be read as an agent saved by FQI.save: it is "
-                         f"truncated or damaged ({type(exc).__name__}: {exc})") from exc
-    if not isinstance(state, dict) or "format" not in state:
-        raise ValueError(f"{path} is a joblib pickle of a {type(state).__name__}, not an "
-                         f"agent saved by FQI.save")
-    if state["format"] != _SAVE_FORMAT:
-        raise ValueError(f"{path} is an FQI save of format version {state['format']!r}; "
-                         f"this version of fqi reads version {_SAVE_FORMAT}")
-    missing = sorted(_SAVE_KEYS - state.keys())
-    if missing:
-        raise ValueError(f"{path} is not an agent saved by FQI.save: it lacks "
-                         f"{', '.join(missing)}")
-    return state
+def _tried(vector, observations):
+    """Reset `vector` and take one step (action 0 everywhere), checking what it returns;
+    the observations of the reset, as the regressor takes them."""
+    calls = {"reset": lambda: vector.reset(),
+             "step": lambda: vector.step(np.zeros(vector.num_envs, dtype=np.intp))}
+    results = {}
+    for name, call in calls.items():
+        try:
+            results[name] = call()
+        except Exception as exc:
+            raise RuntimeError(f"{vector}.{name} raised {type(exc).__name__}: {exc} (FQI "
+                               f"tries the env once when it is set: a reset, then a step "
+                               f"with action 0 in every env)") from exc
+    first = observations.batch(results["reset"][0])
+    obs, rewards, terminated, truncated, _ = results["step"]
+    observations.batch(obs)
+    _checked_step(rewards, terminated, truncated, vector.num_envs)
+    return first
 
 
-def _callback_function(callback):
-    """`callback` as a function ``f(locals_, globals_) -> bool or None``."""
-    if callback is None:
-        return None
-    if callable(getattr(callback, "on_iteration", None)):
-        return lambda locals_, globals_: callback.on_iteration(locals_["self"], locals_["record"])
-    if callable(callback):
-        return callback
-    raise TypeError(f"callback must be callable(locals_, globals_) or have an on_iteration "
-                    f"method; got {type(callback).__name__}")
+def _checked_prediction(prediction, n, describe):
+    """`prediction` for `n` observations, as floats of shape ``(n,)``, after checking there
+    are `n` of them and all are finite; ``describe()`` names the model in the error."""
+    prediction = np.asarray(prediction, dtype=np.float64)
+    bad = ~np.isfinite(prediction)
+    if prediction.size == n and not bad.any():
+        return prediction.reshape(n)
+    model = describe()
+    if prediction.size != n:
+        raise ValueError(f"{model} predicted an array of size {prediction.size} for "
+                         f"{n} observations; a regressor must predict one value per "
+                         f"observation")
+    raise ValueError(f"{model} predicted non-finite Q-values (NaN or inf) for {bad.sum()} "
+                     f"of {n} observations; a regressor must predict finite values")
 
 
 def _nodes_per_tree(models):

@@ -10,17 +10,16 @@ from sklearn.pipeline import make_pipeline
 
 from boxtrees import BoxExtraTreesRegressor, GridCounts
 
-from ._checks import (_check_bool, _check_int, _check_n_jobs, _check_real, _check_seed,
-                      _check_steps)
-from ._evaluate import evaluate
-from ._observations import _observation_batch
-from ._worlds import _world_rules
+from ._checks import _check_bool, _check_int, _check_n_jobs, _check_real, _check_seed
+from ._envs import _spaces
+from ._evaluate import _eval_seeds, evaluate
+from ._observations import _object_bounds, _ObjectRows
 from ._wrappers import GridObservation
 
 __all__ = ["make_box_forest", "make_grid_ridge", "train_dqn", "DQNResult"]
 
-# DQN settings for 400,000 steps of this game: the stable-baselines3 defaults are sized
-# for Atari (1M-step buffer, 10,000-step target updates); these follow the rl-zoo
+# DQN settings for 400,000 steps of an object-set game: the stable-baselines3 defaults are
+# sized for Atari (1M-step buffer, 10,000-step target updates); these follow the rl-zoo
 # settings for small discrete-action tasks (LunarLander-v2), with one gradient step per
 # 4 env steps to keep the CPU cost bounded.
 _DQN_DEFAULTS = {
@@ -31,26 +30,41 @@ _DQN_DEFAULTS = {
 }
 
 
-def make_box_forest(env="ObjectWorld-v0", *, test_type="fixed", test_width=1.0,
-                    n_estimators=30, n_tests=500, min_samples_split=30, n_jobs=-1,
-                    random_state=None):
+def make_box_forest(env=None, *, test_type="fixed", test_width=1.0, n_estimators=30,
+                    n_tests=500, min_samples_split=30, n_jobs=-1, random_state=None,
+                    view_bounds=None):
     """A `boxtrees.BoxExtraTreesRegressor` drawing its tests in the env's view square.
 
     The defaults are the thesis's tuned parameters (M=30, K=500, n_min=30, fixed boxes of
-    half-width TW=1); ``test_type="classic"`` is the classic-trees baseline.
+    half-width TW=1); ``test_type="classic"`` is the classic-trees baseline (axis-aligned
+    splits, also on a ``Box`` env's feature vector).
 
     Parameters
     ----------
-    env : str, gymnasium.Env or envs.WorldRules, default="ObjectWorld-v0"
+    env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable, default=None
+        For object-set observations ``Sequence(Box(shape=(3,)))``, the x and y bounds of
+        its rows are the view square the tests are drawn in. None, or a ``Box`` env: the
+        forest draws them in the bounding box of its training data.
     test_type, test_width, n_estimators, n_tests, min_samples_split, n_jobs, random_state
         As in `boxtrees.BoxExtraTreesRegressor` (``n_jobs=-1``: every core), and checked
         here against its parameter constraints rather than at the first fit.
+    view_bounds : tuple of 4 floats, default=None
+        ``(xmin, xmax, ymin, ymax)``, instead of the env's.
 
     Returns
     -------
     regressor : boxtrees.BoxExtraTreesRegressor
+
+    Examples
+    --------
+    >>> from fqi import make_box_forest
+    >>> make_box_forest(view_bounds=(-10, 10, -10, 10), n_estimators=5).n_tests
+    500
     """
-    view = _world_rules(env).obs_bound
+    if view_bounds is None and env is not None:
+        space = _spaces(env)[0]
+        if not isinstance(space, gym.spaces.Box):
+            view_bounds = _object_bounds(space)[0]
     # what the forest's constraints let through: True for an int, n_jobs=0 (joblib's error)
     n_estimators = _check_int("n_estimators", n_estimators, 1)
     n_tests = _check_int("n_tests", n_tests, 1)
@@ -58,45 +72,60 @@ def make_box_forest(env="ObjectWorld-v0", *, test_type="fixed", test_width=1.0,
         n_jobs = _check_n_jobs(n_jobs)
     forest = BoxExtraTreesRegressor(
         n_estimators, n_tests=n_tests, min_samples_split=min_samples_split,
-        test_type=test_type, test_width=test_width, view_bounds=(-view, view, -view, view),
+        test_type=test_type, test_width=test_width, view_bounds=view_bounds,
         n_jobs=n_jobs, random_state=random_state)
     forest._validate_params()  # the rest, now rather than at the first fit
     return forest
 
 
-def make_grid_ridge(env="ObjectWorld-v0", *, n_bins=10, alpha=1.0):
+def make_grid_ridge(env=None, *, n_bins=10, alpha=1.0, view_bounds=None, n_types=None):
     """The thesis's grid representation: ``make_pipeline(GridCounts(n_bins), Ridge())``.
 
     Parameters
     ----------
-    env : str, gymnasium.Env or envs.WorldRules, default="ObjectWorld-v0"
-        Fixes the grid extent (the view square) and the number of types.
+    env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable, default=None
+        An env observing object sets; the bounds of its rows fix the grid extent (the view
+        square) and the number of types. Needed unless `view_bounds` and `n_types` are
+        given.
     n_bins : int, default=10
         Cells along each axis, at least 1.
     alpha : float, default=1.0
         Ridge penalty, at least 0.
+    view_bounds : tuple of 4 floats, default=None
+    n_types : int, default=None
+        Instead of the env's.
 
     Returns
     -------
     regressor : sklearn.pipeline.Pipeline
+
+    Examples
+    --------
+    >>> from fqi import make_grid_ridge
+    >>> make_grid_ridge(view_bounds=(-10, 10, -10, 10), n_types=4)[0].n_bins
+    10
     """
-    rules = _world_rules(env)
-    view = rules.obs_bound
+    if env is None:
+        if view_bounds is None or n_types is None:
+            raise TypeError("make_grid_ridge needs an env observing object sets, or both "
+                            "view_bounds and n_types")
+    else:
+        view_bounds, n_types = _object_bounds(_spaces(env)[0], view_bounds, n_types)
     return make_pipeline(
-        GridCounts(_check_int("n_bins", n_bins, 1), view_bounds=(-view, view, -view, view),
-                   n_types=rules.n_types),
+        GridCounts(_check_int("n_bins", n_bins, 1), view_bounds=view_bounds, n_types=n_types),
         Ridge(alpha=_check_real("alpha", alpha, 0.0, np.inf, high_inclusive=False)))
 
 
 class _GridModelPolicy:
     """A model trained on `GridObservation` features, playing from object sets."""
 
-    def __init__(self, model, grid):
+    def __init__(self, model, grid, observations):
         self.model = model
         self.grid = grid
+        self._observations = observations
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        sets, single = _observation_batch(observation)
+        sets, single = self._observations.as_input(observation)
         features = self.grid.transform(sets).astype(np.float32)
         actions, _ = self.model.predict(features, deterministic=deterministic)
         return (actions[0] if single else actions), None
@@ -110,9 +139,9 @@ class DQNResult:
     ----------
     model : stable_baselines3.DQN
     policy : object
-        Plays from object sets (``policy.predict(ragged_batch)``), for `fqi.evaluate`.
+        Plays from object sets (``policy.predict(batch)``), for `fqi.evaluate`.
     reward : float
-        `fqi.evaluate` score (NaN when ``eval_steps=0``).
+        Total return of the evaluation episodes (NaN when ``eval_episodes=0``).
     train_seconds, eval_seconds : float
         Wall time of ``model.learn`` and of the evaluation.
     total_timesteps : int
@@ -126,26 +155,25 @@ class DQNResult:
     total_timesteps: int
 
 
-def train_dqn(env="ObjectWorld-v0", total_timesteps=400_000, *, n_bins=10, gamma=0.5,
-              eval_steps=20_000, seed=None, torch_threads=1, progress_bar=False,
-              **dqn_kwargs):
+def train_dqn(env, total_timesteps=400_000, *, n_bins=10, gamma=0.5, eval_episodes=None,
+              eval_seeds=None, seed=None, torch_threads=1, progress_bar=False, **dqn_kwargs):
     """Train stable-baselines3 `DQN` on `GridObservation` and score it with `fqi.evaluate`.
 
     Parameters
     ----------
-    env : str, default="ObjectWorld-v0"
-        Registered id of the game variant (a fresh env is made for training).
+    env : str
+        Registered id of an env observing object sets (a fresh env is made for training).
     total_timesteps : int, default=400_000
         Environment steps (20 FQI iterations of 20,000 samples are 400,000).
     n_bins : int, default=10
         Grid cells per axis of the observation.
     gamma : float, default=0.5
         Discount factor in ``[0, 1]`` (the FQI default, for a like-for-like comparison).
-    eval_steps : int, default=20_000
-        Steps of the evaluation on the reference worlds, a multiple of the episode length
-        (50); 0 skips it.
+    eval_episodes, eval_seeds
+        The evaluation after training, as `fqi.evaluate`'s `n_episodes` and `seeds`
+        (default: 10 episodes on seeds from ``2**40``); ``eval_episodes=0`` skips it.
     seed : int >= 0 or None, default=None
-        Seeds DQN (and through it the training worlds, below ``2**40``).
+        Seeds DQN (and through it the training resets, below ``2**40``).
     torch_threads : int, default=1
         Torch threads while training (restored afterwards). On 2 shared cores the
         default thread pool ran 12x slower than one thread (measured, README "fqi").
@@ -165,10 +193,9 @@ def train_dqn(env="ObjectWorld-v0", total_timesteps=400_000, *, n_bins=10, gamma
 
     if not isinstance(env, str):
         raise TypeError(f"env must be a registered env id, got {type(env).__name__}")
-    rules = _world_rules(env)
     total_timesteps = _check_int("total_timesteps", total_timesteps, 1)
     gamma = _check_real("gamma", gamma, 0.0, 1.0)
-    eval_steps = _check_steps("eval_steps", eval_steps, rules.max_steps, allow_zero=True)
+    seeds = _eval_seeds(eval_episodes, eval_seeds, "eval_episodes", "eval_seeds")
     seed = _check_seed("seed", seed)
     torch_threads = _check_int("torch_threads", torch_threads, 1)
     progress_bar = _check_bool("progress_bar", progress_bar)
@@ -186,8 +213,9 @@ def train_dqn(env="ObjectWorld-v0", total_timesteps=400_000, *, n_bins=10, gamma
         trained = time.perf_counter()
     finally:
         torch.set_num_threads(threads)
-    policy = _GridModelPolicy(model, train_env.grid)
-    reward = evaluate(policy, env, eval_steps) if eval_steps else np.nan
+    policy = _GridModelPolicy(model, train_env.grid,
+                              _ObjectRows(train_env.env.observation_space))
+    reward = evaluate(policy, env, seeds=seeds).total if seeds else np.nan
     train_env.close()
     return DQNResult(model, policy, reward, trained - start, time.perf_counter() - trained,
                      total_timesteps)

@@ -51,11 +51,10 @@ def _check_n_jobs(value):
     return int(value)
 
 
-def _check_steps(name, value, episode_length, allow_zero):
-    """`value` as an int multiple of `episode_length`, positive unless `allow_zero`."""
-    value = _check_int(name, value, 0)
-    if value % episode_length or (value == 0 and not allow_zero):
-        what = "0 or a positive" if allow_zero else "a positive"
-        raise ValueError(f"{name} must be {what} multiple of the episode length "
-                         f"{episode_length}; got {value}")
-    return value
+def _check_verbose(value):
+    """`value` as an int ``>= 0`` (a bool counts as 0 or 1)."""
+    if not isinstance(value, (Integral, np.bool_)):
+        raise TypeError(f"verbose must be an int or a bool, got {value!r}")
+    if value < 0:
+        raise ValueError(f"verbose must be >= 0, got {value}")
+    return int(value)

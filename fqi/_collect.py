@@ -1,32 +1,28 @@
-"""Rollouts on many worlds at once, and the transitions they produce."""
+"""Rollouts on a gymnasium vector env, and the transitions they produce."""
 from dataclasses import dataclass
 
 import numpy as np
+from gymnasium.vector import AutoresetMode
 
-from boxtrees import ObjectSets
-
-from ._observations import _as_object_sets
-from ._worlds import _batched_world
+from ._envs import _TRAINING_SEED_END, _autoreset_mode, _seeded_reset
 
 __all__ = []
-
-# Training worlds draw their seeds below this (the reference worlds start at 2**40).
-_TRAINING_SEED_END = 2**40
 
 
 @dataclass
 class _Transitions:
     """Transitions ``(s, a, r, s', terminated)``, one per sample, in collection order.
 
-    ``next_values`` holds ``max_a Q(s', a)`` under the Q-function that collected them (None
-    when unknown); they are the next iteration's bootstrap values for free, and stale as
-    soon as Q changes.
+    ``states`` and ``next_states`` are batches in the regressor's format (a float matrix or
+    a `boxtrees.ObjectSets`). ``next_values`` holds ``max_a Q(s', a)`` under the Q-function
+    that collected them (None when unknown); they are the next iteration's bootstrap values
+    for free, and stale as soon as Q changes.
     """
 
-    states: ObjectSets
+    states: object
     actions: np.ndarray
     rewards: np.ndarray
-    next_states: ObjectSets
+    next_states: object
     terminated: np.ndarray
     next_values: np.ndarray = None
 
@@ -39,71 +35,131 @@ class _Transitions:
                             None if self.next_values is None else self.next_values[index])
 
     @classmethod
-    def concatenate(cls, parts):
+    def concatenate(cls, parts, join):
+        """`parts` joined in order; `join` concatenates their state batches."""
         values = [p.next_values for p in parts]
-        return cls(ObjectSets.concatenate([p.states for p in parts]),
-                   np.concatenate([p.actions for p in parts]),
+        return cls(join([p.states for p in parts]), np.concatenate([p.actions for p in parts]),
                    np.concatenate([p.rewards for p in parts]),
-                   ObjectSets.concatenate([p.next_states for p in parts]),
+                   join([p.next_states for p in parts]),
                    np.concatenate([p.terminated for p in parts]),
                    None if any(v is None for v in values) else np.concatenate(values))
 
 
 class _Collector:
-    """Plays `n_worlds` training worlds in lockstep and records their transitions.
+    """Plays the envs of a gymnasium `VectorEnv` and records their transitions.
 
-    Episodes run on across calls to `collect`; when the worlds' episodes end (all together:
-    `BatchedObjectWorld` truncates every world after ``max_steps``), the worlds are reset,
-    each continuing its own generator. The first reset seeds the worlds from `rng` with
-    seeds below ``2**40``, so the reference worlds are never trained on.
+    Episodes run on across calls to `collect`, each env at its own pace, and restart through
+    the vector env's autoreset (``metadata["autoreset_mode"]``): in gymnasium's ``NEXT_STEP``
+    mode the step after an episode's end only resets that env and is not a transition; in
+    ``SAME_STEP`` mode the final observation comes from ``info["final_obs"]``; with
+    ``DISABLED`` the ended envs are reset through ``reset_mask``. The first reset seeds each
+    env with a seed drawn from `rng` below ``2**40``.
+
+    Parameters
+    ----------
+    env : gymnasium.vector.VectorEnv
+    observations : _FeatureRows or _ObjectRows
+        Reads the env's observations.
+    rng : numpy.random.Generator
     """
 
-    def __init__(self, rules, n_worlds, rng):
-        self.env = _batched_world(rules, n_worlds)
+    def __init__(self, env, observations, rng):
+        self.env = env
+        self.observations = observations
+        self.mode = _autoreset_mode(env)
         self._rng = rng
         self._obs = None
+        self._resetting = None  # NEXT_STEP: the envs whose next step is a reset
 
     def collect(self, n_samples, policy, q_values=None):
-        """Record the first `n_samples` transitions of ``ceil(n_samples / n_worlds)`` steps.
+        """Record the first `n_samples` transitions of the steps it takes to get them.
 
         Parameters
         ----------
         n_samples : int
         policy : callable
-            ``policy(obs, q) -> actions``, one action per world, for an ObjectSets of
-            observations and their Q-values ``q = q_values(obs)`` (None without
-            `q_values`).
+            ``policy(obs, q) -> actions`` for a batch of observations (the envs that play
+            this step) and their Q-values ``q`` (None without `q_values`).
         q_values : callable, default=None
-            ``q_values(obs) -> (n_worlds, n_actions)`` array. The Q-values of each step's
-            observations serve twice: to act, and as the previous step's next-state values
-            (``next_values``); only episode ends and the last step need an extra call.
+            ``q_values(obs) -> (n, n_actions)`` array. In ``NEXT_STEP`` mode the Q-values of
+            each step's observations serve twice: to act, and as the previous step's
+            next-state values (``next_values``), so only the last step needs an extra call.
 
         Returns
         -------
         transitions : _Transitions
+        n_steps : int
+            Transitions taken, including those beyond `n_samples` of the last step.
         """
-        n_worlds = self.env.num_envs
-        parts = []
-        pending = None  # the step whose next states are the current observations
-        for _ in range(-(-n_samples // n_worlds)):
+        n_envs = self.env.num_envs
+        reuse = q_values is not None and self.mode is AutoresetMode.NEXT_STEP
+        parts, count = [], 0
+        pending = None  # (transitions, their envs): next states are the current observations
+        while count < n_samples:
             if self._obs is None:
-                seeds = self._rng.integers(_TRAINING_SEED_END, size=n_worlds)
-                self._obs = _as_object_sets(self.env.reset(seed=seeds.tolist())[0])
-            obs = self._obs
-            q = None if q_values is None else q_values(obs)
+                seeds = self._rng.integers(_TRAINING_SEED_END, size=n_envs).tolist()
+                self._obs = self.observations.batch(_seeded_reset(self.env, seeds))
+                self._resetting = np.zeros(n_envs, dtype=bool)
+            obs, live = self._obs, ~self._resetting
+            everyone = live.all()
+            q = None
+            if q_values is not None and (pending is not None or live.any()):
+                q = q_values(obs)
             if pending is not None:
-                pending.next_values = q.max(axis=1)
-            actions = np.asarray(policy(obs, q), dtype=np.intp)
-            next_obs, rewards, terminated, truncated, _ = self.env.step(actions)
-            part = _Transitions(obs, actions, rewards, _as_object_sets(next_obs),
-                                terminated.copy())
-            parts.append(part)
-            done = bool((terminated | truncated).any())
-            # lockstep worlds: reset them all together when an episode ends
-            self._obs = _as_object_sets(self.env.reset()[0]) if done else part.next_states
-            pending = part if q_values is not None and not done else None
-            if q_values is not None and done:
-                part.next_values = q_values(part.next_states).max(axis=1)
+                pending[0].next_values = q[pending[1]].max(axis=1)
+                pending = None
+            actions = np.zeros(n_envs, dtype=np.intp)
+            if everyone:
+                actions[:] = policy(obs, q)
+            elif live.any():
+                actions[live] = policy(obs[live], None if q is None else q[live])
+            next_obs, rewards, terminated, truncated = self._step(actions)
+            if live.any():
+                part = _Transitions(obs, actions, rewards, next_obs, terminated)
+                part = part if everyone else part[live]
+                parts.append(part)
+                count += len(part)
+                if reuse:
+                    pending = (part, slice(None) if everyone else live)
         if pending is not None:
-            pending.next_values = q_values(pending.next_states).max(axis=1)
-        return _Transitions.concatenate(parts)[:n_samples]
+            pending[0].next_values = q_values(pending[0].next_states).max(axis=1)
+        data = _Transitions.concatenate(parts, self.observations.concatenate)
+        return data[:n_samples], count
+
+    def _step(self, actions):
+        """Step every env; returns the true next states, rewards, terminations and
+        truncations, and leaves the observations to act on next in ``self._obs``."""
+        obs, rewards, terminated, truncated, info = self.env.step(actions)
+        rewards, terminated, truncated = _checked_step(rewards, terminated, truncated,
+                                                       self.env.num_envs)
+        ended = terminated | truncated
+        self._obs = self.observations.batch(obs)
+        next_obs = self._obs
+        if self.mode is AutoresetMode.NEXT_STEP:
+            self._resetting = ended
+        elif ended.any() and self.mode is AutoresetMode.SAME_STEP:
+            next_obs = self.observations.replaced(self._obs, ended, info["final_obs"][ended])
+        elif ended.any():  # DISABLED: reset the ended envs ourselves
+            obs, _ = self.env.reset(options={"reset_mask": ended})
+            self._obs = self.observations.batch(obs)
+        return next_obs, rewards, terminated, truncated
+
+
+def _checked_step(rewards, terminated, truncated, n_envs):
+    """The step's rewards (float64) and flags (bool), checked: one finite reward and one
+    flag of each kind per env."""
+    rewards = np.asarray(rewards)
+    if rewards.shape != (n_envs,) or rewards.dtype.kind not in "biuf":
+        raise ValueError(f"the env returned rewards of shape {rewards.shape} and dtype "
+                         f"{rewards.dtype}; expected one number per env, shape ({n_envs},)")
+    if not np.isfinite(rewards).all():
+        raise ValueError(f"the env returned non-finite rewards (NaN or inf): "
+                         f"{rewards[~np.isfinite(rewards)][:3].tolist()}")
+    flags = []
+    for name, flag in (("terminated", terminated), ("truncated", truncated)):
+        flag = np.asarray(flag)
+        if flag.shape != (n_envs,) or flag.dtype.kind not in "biu":
+            raise ValueError(f"the env returned {name} of shape {flag.shape} and dtype "
+                             f"{flag.dtype}; expected one bool per env, shape ({n_envs},)")
+        flags.append(flag.astype(bool))
+    return rewards.astype(np.float64), *flags

@@ -1,12 +1,63 @@
-"""The thesis's evaluation: greedy play on fixed reference worlds, total reward."""
+"""Greedy play on fixed reset seeds: total and mean return, for any policy with ``predict``."""
+from dataclasses import dataclass
+
 import numpy as np
+from gymnasium.vector import AutoresetMode
 
-from envs import reference_worlds
+from ._checks import _check_int, _check_seed
+from ._envs import (_TRAINING_SEED_END, _autoreset_mode, _make_vector, _n_actions,
+                    _seeded_reset, _spaces)
+from ._observations import _observation_format
 
-from ._checks import _check_seed, _check_steps
-from ._worlds import _batched_world, _world_rules
+__all__ = ["evaluate", "Evaluation", "RandomPolicy"]
 
-__all__ = ["evaluate", "RandomPolicy"]
+_DEFAULT_EPISODES = 10
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """What `evaluate` returns.
+
+    Attributes
+    ----------
+    total : float
+        Sum of the episodes' returns (the thesis's score: 400 episodes of 50 steps).
+    mean, std : float
+        Mean and standard deviation of the episodes' returns.
+    returns : ndarray of float64 of shape (n_episodes,)
+        Undiscounted return of each episode, in the order of the seeds.
+    lengths : ndarray of int of shape (n_episodes,)
+        Steps of each episode.
+    seeds : tuple of int
+        The reset seed of each episode.
+    """
+
+    total: float
+    mean: float
+    std: float
+    returns: np.ndarray
+    lengths: np.ndarray
+    seeds: tuple
+
+
+def _eval_seeds(n_episodes, seeds, name="n_episodes", seeds_name="seeds"):
+    """The reset seeds of an evaluation: `seeds` (checked, and `n_episodes` of them when
+    both are given), else ``2**40, 2**40 + 1, ...``, `n_episodes` of them (default 10);
+    none for ``n_episodes=0``."""
+    if n_episodes is not None:
+        n_episodes = _check_int(name, n_episodes, 0)
+        if n_episodes == 0:
+            return ()
+    if seeds is None:
+        n = _DEFAULT_EPISODES if n_episodes is None else n_episodes
+        return tuple(range(_TRAINING_SEED_END, _TRAINING_SEED_END + n))
+    if isinstance(seeds, (str, bytes)) or not hasattr(seeds, "__len__"):
+        raise TypeError(f"{seeds_name} must be a sequence of ints, got {seeds!r}")
+    seeds = tuple(_check_int(f"{seeds_name}[{i}]", s, 0) for i, s in enumerate(seeds))
+    if n_episodes is not None and n_episodes != len(seeds):
+        raise ValueError(f"{name}={n_episodes} but {len(seeds)} {seeds_name} were given; "
+                         f"give one seed per episode (or leave {name} out)")
+    return seeds
 
 
 class RandomPolicy:
@@ -14,88 +65,136 @@ class RandomPolicy:
 
     Parameters
     ----------
-    env : str, gymnasium.Env or envs.WorldRules
-        The ObjectWorld whose actions are drawn.
+    env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable
+        The env whose actions are drawn (its action space must be ``Discrete``) and whose
+        observations it is given (one, or a batch).
     seed : int >= 0 or None, default=None
         Seeds the actions.
 
     Examples
     --------
     >>> from fqi import RandomPolicy, evaluate
-    >>> score = evaluate(RandomPolicy("ObjectWorld-v0", seed=0), "ObjectWorld-v0", n_steps=500)
+    >>> result = evaluate(RandomPolicy("CartPole-v1", seed=0), "CartPole-v1", n_episodes=5)
+    >>> result.returns.shape
+    (5,)
     """
 
     def __init__(self, env, seed=None):
-        self.n_actions = _world_rules(env).n_actions
+        observation_space, action_space = _spaces(env)
+        self.n_actions = _n_actions(action_space)
+        self._observations = _observation_format(observation_space)
         self._rng = np.random.default_rng(_check_seed("seed", seed))
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        """Uniform random actions: one per world for a batch (``len(observation)``
-        worlds when it has ``offsets``), else one.
+        """Uniform random actions: one for one observation, one per observation of a batch.
 
         Returns
         -------
         actions : int or ndarray of int
         state : None
         """
-        if hasattr(observation, "offsets"):
-            return self._rng.integers(self.n_actions, size=len(observation.offsets) - 1), None
-        return self._rng.integers(self.n_actions), None
+        batch, single = self._observations.as_input(observation)
+        if single:
+            return self._rng.integers(self.n_actions), None
+        return self._rng.integers(self.n_actions, size=len(batch)), None
 
 
-def evaluate(policy, env="ObjectWorld-v0", n_steps=20_000):
-    """Total reward of a policy over `n_steps` steps on the fixed reference worlds.
+def evaluate(policy, env, n_episodes=None, seeds=None):
+    """Play one episode per reset seed with the policy's greedy actions.
 
-    One episode of ``max_steps`` (50) steps is played on each of the first
-    ``n_steps / max_steps`` reference worlds (`envs.reference_worlds`, which training never
-    sees), all in lockstep on one `envs.BatchedObjectWorld`: the default 20,000 steps are
-    the thesis's 400 episodes of 50 steps.
+    The episodes run side by side on a vector env (one env per episode; a given
+    `gymnasium.vector.VectorEnv` plays them in rounds of its size), each reset with its
+    own seed and played until it terminates or is truncated. Nothing else is random, so the
+    same policy scores the same. The thesis's evaluation is ``seeds=envs.reference_worlds(
+    400)`` on ObjectWorld: 400 episodes of 50 steps, 20,000 steps, scored by ``total``.
 
     Parameters
     ----------
     policy : object
-        Anything with ``predict(obs, deterministic=True) -> (actions, state)`` that accepts
-        a batch of observations with ``data`` and ``offsets`` (an `envs.RaggedBatch`): an
-        `FQI` agent, `RandomPolicy`, `envs.GreedyPolicy`, or the DQN policy of `train_dqn`.
-        Its actions must be one int in ``[0, n_actions)`` per world (else a ValueError).
-    env : str, gymnasium.Env or envs.WorldRules, default="ObjectWorld-v0"
-        The game variant (its rules; the reference worlds are fixed by the seeds).
-    n_steps : int, default=20_000
-        Total steps, a positive multiple of ``max_steps``.
+        Anything with ``predict(obs, deterministic=True) -> (actions, state)`` taking a batch
+        of observations as the vector env returns them (an `FQI` agent, `RandomPolicy`, a
+        stable-baselines3 model on a ``Box`` env): one int action in ``[0, n_actions)`` per
+        env (else a ValueError).
+    env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable
+        As for `FQI`. Its episodes must end (a time limit).
+    n_episodes : int, default=None
+        Number of episodes: ``len(seeds)`` when seeds are given, else 10.
+    seeds : sequence of int, default=None
+        One reset seed per episode. Default: ``2**40, 2**40 + 1, ...``, seeds that `FQI`
+        never trains on (it draws its reset seeds below ``2**40``). A vector env whose envs
+        share one generator and take a single int seed (gymnasium's ``CartPoleVectorEnv``,
+        behind ``"CartPole-v1"``) is reset with ``seeds[0]``: its episodes are then fixed
+        by that seed and their number, not by one seed each (use
+        ``gymnasium.make_vec(id, n, vectorization_mode="sync")`` for per-episode seeds).
 
     Returns
     -------
-    total_reward : float
+    result : Evaluation
+        ``total``, ``mean`` and ``std`` of the returns, and each episode's return and length.
+
+    Examples
+    --------
+    >>> import gymnasium as gym
+    >>> from fqi import RandomPolicy, evaluate
+    >>> env = gym.make_vec("CartPole-v1", 3, vectorization_mode="sync")
+    >>> result = evaluate(RandomPolicy(env, seed=0), env, seeds=[0, 1, 2])
+    >>> result.total == evaluate(RandomPolicy(env, seed=0), env, seeds=[0, 1, 2]).total
+    True
+    >>> result.returns.shape, bool(result.total == result.returns.sum())
+    ((3,), True)
     """
     if not callable(getattr(policy, "predict", None)):
         raise TypeError(f"policy must have a method predict(observation, deterministic=True) "
                         f"returning (actions, state); {type(policy).__name__} has no predict")
-    rules = _world_rules(env)
-    n_steps = _check_steps("n_steps", n_steps, rules.max_steps, allow_zero=False)
-    n_episodes = n_steps // rules.max_steps
-    worlds = _batched_world(rules, n_episodes)
-    obs, _ = worlds.reset(seed=reference_worlds(n_episodes))
-    total = 0.0
-    for _ in range(rules.max_steps):
-        actions = _policy_actions(policy, obs, rules.n_actions)
-        obs, rewards, _, _, _ = worlds.step(actions)
-        total += float(rewards.sum())
-    return total
+    seeds = _eval_seeds(n_episodes, seeds)
+    if not seeds:
+        raise ValueError("n_episodes must be >= 1 (or give at least one seed)")
+    vector = _make_vector(env, len(seeds))
+    n_actions = _n_actions(vector.single_action_space)
+    returns, lengths = [], []
+    for start in range(0, len(seeds), vector.num_envs):
+        round_returns, round_lengths = _play_round(policy, vector, n_actions,
+                                                   seeds[start:start + vector.num_envs])
+        returns.append(round_returns)
+        lengths.append(round_lengths)
+    returns, lengths = np.concatenate(returns), np.concatenate(lengths)
+    return Evaluation(float(returns.sum()), float(returns.mean()), float(returns.std()),
+                      returns, lengths, seeds)
 
 
-def _policy_actions(policy, obs, n_actions):
+def _play_round(policy, vector, n_actions, seeds):
+    """Returns and lengths of one episode per seed, on the first ``len(seeds)`` envs of
+    `vector` (the others replay the same seeds and are not counted)."""
+    n_envs = vector.num_envs
+    obs = _seeded_reset(vector, (list(seeds) * n_envs)[:n_envs])
+    mode = _autoreset_mode(vector)
+    returns, lengths = np.zeros(n_envs), np.zeros(n_envs, dtype=np.intp)
+    playing = np.ones(n_envs, dtype=bool)
+    counted = slice(len(seeds))
+    while playing[counted].any():
+        actions = _policy_actions(policy, obs, n_actions, n_envs)
+        obs, rewards, terminated, truncated, _ = vector.step(actions)
+        returns[playing] += np.asarray(rewards, dtype=np.float64)[playing]
+        lengths[playing] += 1
+        ended = playing & (np.asarray(terminated) | np.asarray(truncated))
+        playing &= ~ended
+        if ended.any() and mode is AutoresetMode.DISABLED:
+            obs, _ = vector.reset(options={"reset_mask": ended})
+    return returns[counted], lengths[counted]
+
+
+def _policy_actions(policy, obs, n_actions, n_envs):
     """The actions of ``policy.predict`` for the batch `obs`, checked to be one int in
-    ``[0, n_actions)`` per world, as an array of shape ``(len(obs),)``."""
+    ``[0, n_actions)`` per env, as an array of shape ``(n_envs,)``."""
     out = policy.predict(obs, deterministic=True)
     if not isinstance(out, tuple) or len(out) != 2:
         raise TypeError(f"policy.predict must return a pair (actions, state) as in "
                         f"stable-baselines3; it returned a {type(out).__name__}")
     actions = np.asarray(out[0])
-    n_worlds = len(obs)
-    if actions.size != n_worlds:
+    if actions.size != n_envs:
         raise ValueError(f"policy.predict returned {actions.size} actions (shape "
-                         f"{actions.shape}) for a batch of {n_worlds} observations; expected "
-                         f"{n_worlds}, one per world")
+                         f"{actions.shape}) for a batch of {n_envs} observations; expected "
+                         f"{n_envs}, one per env")
     if actions.dtype.kind not in "iu":
         raise ValueError(f"policy.predict must return int actions in [0, {n_actions}); it "
                          f"returned dtype {actions.dtype}")
@@ -103,4 +202,4 @@ def _policy_actions(policy, obs, n_actions):
     if invalid.any():
         raise ValueError(f"policy.predict returned action {actions[invalid].flat[0]}; the "
                          f"action space is Discrete({n_actions}), ints in [0, {n_actions})")
-    return actions.reshape(n_worlds)
+    return actions.reshape(n_envs)

@@ -5,7 +5,7 @@ from gymnasium import spaces
 
 from boxtrees import GridCounts
 
-from ._worlds import _world_rules
+from ._observations import _object_bounds
 
 __all__ = ["GridObservation"]
 
@@ -13,42 +13,51 @@ __all__ = ["GridObservation"]
 class GridObservation(gym.ObservationWrapper):
     """Observe the per-cell, per-type object counts of an ``n_bins x n_bins`` grid.
 
-    The featurisation is `boxtrees.GridCounts` over the view square
-    ``[-view_size, view_size]^2`` with the env's ``n_types`` types (the thesis's grid
-    representation), so the vector is laid out as ``GridCounts.transform`` documents.
+    The featurisation is `boxtrees.GridCounts` over the view square with ``n_types`` types
+    (the thesis's grid representation), so the vector is laid out as
+    ``GridCounts.transform`` documents.
 
     Parameters
     ----------
     env : gymnasium.Env
-        An ObjectWorld env (wrappers allowed) with a Discrete action space.
+        An env (wrappers allowed) observing object sets, ``Sequence(Box(shape=(3,)))``
+        rows ``[x, y, type]``.
     n_bins : int, default=10
         Cells along each axis.
+    view_bounds : tuple of 4 floats, default=None
+        ``(xmin, xmax, ymin, ymax)`` of the grid; default: the x and y bounds of the
+        observation space's rows.
+    n_types : int, default=None
+        Number of object types; default: the upper bound of the rows' type column, plus 1.
 
     Attributes
     ----------
     grid : boxtrees.GridCounts
         The fitted transformer; ``grid.transform(batch)`` featurises a batch of
-        observations (e.g. an `envs.RaggedBatch`) at once.
+        observations (e.g. a `boxtrees.ObjectSets`) at once.
 
     Examples
     --------
     >>> import gymnasium as gym
-    >>> import envs
+    >>> import numpy as np
     >>> from fqi import GridObservation
-    >>> env = GridObservation(gym.make("ObjectWorld-v0"), n_bins=10)
-    >>> env.reset(seed=0)[0].shape
-    (400,)
+    >>> class Objects(gym.Env):  # one object of type 0 at (1, 2); types 0 .. 3 in [-10, 10]^2
+    ...     observation_space = gym.spaces.Sequence(gym.spaces.Box(
+    ...         np.array([-10, -10, 0]), np.array([10, 10, 3]), dtype=np.float32), stack=True)
+    ...     action_space = gym.spaces.Discrete(2)
+    ...     def reset(self, *, seed=None, options=None):
+    ...         return np.array([[1.0, 2.0, 0.0]], dtype=np.float32), {}
+    >>> env = GridObservation(Objects(), n_bins=10)
+    >>> obs, _ = env.reset()
+    >>> obs.shape, obs.sum()
+    ((400,), np.float32(1.0))
     """
 
-    def __init__(self, env, n_bins=10):
+    def __init__(self, env, n_bins=10, view_bounds=None, n_types=None):
         super().__init__(env)
-        rules = _world_rules(env)
-        if not isinstance(env.observation_space, spaces.Sequence):
-            raise ValueError(f"GridObservation needs object-set observations (a Sequence "
-                             f"space); got {env.observation_space}")
-        view = rules.obs_bound
-        self.grid = GridCounts(n_bins, view_bounds=(-view, view, -view, view),
-                               n_types=rules.n_types).fit([np.empty((0, 3))])
+        view_bounds, n_types = _object_bounds(env.observation_space, view_bounds, n_types)
+        self.grid = GridCounts(n_bins, view_bounds=view_bounds,
+                               n_types=n_types).fit([np.empty((0, 3))])
         n_features = len(self.grid.get_feature_names_out())
         self.observation_space = spaces.Box(0.0, np.inf, shape=(n_features,), dtype=np.float32)
 

@@ -1,4 +1,5 @@
-"""The FQI agent: SB3-style API, data regimes, determinism, persistence, learning, bad input."""
+"""The FQI agent on ObjectWorld: SB3-style API, data regimes, determinism, persistence, the
+thesis's numbers, learning, baselines, bad input. Other envs: test_fqi_envs.py."""
 import csv
 import os
 import tempfile
@@ -16,8 +17,10 @@ from boxtrees import BoxExtraTreesRegressor, ObjectSets
 from fqi import (FQI, GridObservation, RandomPolicy, evaluate, make_box_forest,
                  make_grid_ridge, train_dqn)
 from fqi._collect import _Collector, _Transitions
+from fqi._observations import _observation_format
 
 ENV = "ObjectWorld-v0"
+REFERENCE = envs.reference_worlds(400)  # the thesis's evaluation: 400 episodes of 50 steps
 
 
 def small_forest(**params):
@@ -26,7 +29,7 @@ def small_forest(**params):
 
 
 def small_agent(regressor=None, **params):
-    settings = dict(samples_per_iteration=1000, n_worlds=50, eval_steps=500, seed=0)
+    settings = dict(samples_per_iteration=1000, n_envs=50, eval_seeds=REFERENCE[:10], seed=0)
     settings.update(params)
     return FQI(small_forest() if regressor is None else regressor, ENV, **settings)
 
@@ -90,23 +93,15 @@ def test_callback_sees_every_iteration_and_can_stop():
         assert locals_["self"].iteration == len(seen)
         return len(seen) < 2  # stop after the second iteration
 
-    agent = small_agent(eval_steps=0).learn(5, callback=plain)
+    agent = small_agent(eval_episodes=0).learn(5, callback=plain)
     assert seen == [0, 1] and agent.iteration == 2
-
-    class Watcher:
-        def __init__(self):
-            self.rewards = []
-
-        def on_iteration(self, agent, record):
-            self.rewards.append(record["reward"])
-
-    watcher = Watcher()
-    agent = small_agent().learn(3, callback=watcher)
-    assert watcher.rewards == [r["reward"] for r in agent.history] and len(watcher.rewards) == 3
+    rewards = []
+    agent = small_agent().learn(3, callback=lambda l, g: rewards.append(l["record"]["reward"]))
+    assert rewards == [r["reward"] for r in agent.history] and len(rewards) == 3
 
 
 def test_progress_bar_and_verbose(capsys):
-    small_agent(eval_steps=0, verbose=1).learn(2, progress_bar=True)
+    small_agent(eval_episodes=0, verbose=1).learn(2, progress_bar=True)
     captured = capsys.readouterr()
     assert "FQI" in captured.err and "2/2" in captured.err  # tqdm writes to stderr
     assert captured.out.count("iteration") == 2
@@ -119,8 +114,8 @@ def test_csv_log_has_one_row_per_iteration(tmp_path):
     with path.open() as f:
         rows = list(csv.DictReader(f))
     assert [int(r["iteration"]) for r in rows] == [0, 1, 2]
-    for key in ("reward", "t_collect", "t_targets", "t_fit", "t_evaluate", "n_samples",
-                "nodes_per_tree"):
+    for key in ("reward", "mean_return", "t_collect", "t_targets", "t_fit", "t_evaluate",
+                "n_samples", "nodes_per_tree"):
         assert float(rows[-1][key]) == pytest.approx(agent.history[-1][key])
     assert float(rows[1]["nodes_per_tree"]) > 1
 
@@ -134,7 +129,9 @@ def test_save_load_round_trip(trained, tmp_path):
     np.testing.assert_array_equal(loaded.predict(obs)[0], trained.predict(obs)[0])
     np.testing.assert_array_equal(loaded.q_values(obs), trained.q_values(obs))
     assert loaded.history == trained.history and loaded.iteration == 2
-    assert loaded.gamma == trained.gamma and loaded.rules == trained.rules
+    assert loaded.gamma == trained.gamma and loaded.eval_seeds == trained.eval_seeds
+    assert loaded.observation_space == trained.observation_space
+    assert isinstance(loaded.get_env(), envs.BatchedObjectWorld)  # from the saved id
     loaded.learn(1)  # training continues on fresh data
     assert loaded.iteration == 3 and loaded.num_timesteps == 3000
 
@@ -148,25 +145,32 @@ def test_same_seed_same_reward_curve():
     assert curve(8) != first
 
 
+def _collector(worlds, seed=0):
+    return _Collector(worlds, _observation_format(worlds.single_observation_space),
+                      np.random.default_rng(seed))
+
+
 def test_training_never_sees_reference_worlds():
     seeds = []
-    collector = _Collector(envs.WorldRules(), 20, np.random.default_rng(0))
-    reset = collector.env.reset
+    worlds = envs.BatchedObjectWorld(20)
+    reset = worlds.reset
 
     def spy(*, seed=None, options=None):
         seeds.append(seed)
         return reset(seed=seed, options=options)
 
-    collector.env.reset = spy
-    collector.collect(2000, lambda obs, q: np.zeros(len(obs), dtype=int))
-    assert seeds[1:] == [None, None]  # 2 episodes, then each world continues its generator
+    worlds.reset = spy
+    data, steps = _collector(worlds).collect(2050, lambda obs, q: np.zeros(len(obs), dtype=int))
+    assert steps == 2060 and len(data) == 2050  # 100 steps: 2 episodes, 1 step of a third
+    # one seeded reset; then the batched engine's autoreset continues each world's generator
+    assert seeds[1:] == [None, None]
     assert len(seeds[0]) == 20 and max(seeds[0]) < envs.REFERENCE_SEED_START
 
 
 # ---------------------------------------------------------------- algorithm
 def test_collection_reuses_q_values_as_next_state_values():
     q = ObjectCountQ().predict
-    collector = _Collector(envs.WorldRules(max_steps=7), 30, np.random.default_rng(0))
+    collector = _collector(envs.BatchedObjectWorld(30, max_steps=7))
 
     def q_values(sets):
         base = q(sets)
@@ -175,7 +179,7 @@ def test_collection_reuses_q_values_as_next_state_values():
     def policy(obs, values):
         return values.argmax(axis=1) % 4
 
-    data = collector.collect(30 * 10 + 5, policy, q_values)  # crosses an episode end
+    data, _ = collector.collect(30 * 10 + 5, policy, q_values)  # crosses an episode end
     assert len(data) == 305
     np.testing.assert_array_equal(data.next_values, q_values(data.next_states).max(axis=1))
     np.testing.assert_array_equal(data.states[30:60].data, data.next_states[:30].data)
@@ -204,7 +208,7 @@ def test_targets_bootstrap_through_truncation_but_not_termination():
 
 def test_regimes_collect_when_they_should():
     def new_samples(**params):
-        agent = small_agent(eval_steps=0, **params).learn(7)
+        agent = small_agent(eval_episodes=0, **params).learn(7)
         return [r["new_samples"] for r in agent.history], [r["n_samples"] for r in agent.history]
 
     assert new_samples(resample_every=1) == ([1000] * 7, [1000] * 7)
@@ -215,7 +219,7 @@ def test_regimes_collect_when_they_should():
 
 
 def test_missing_action_keeps_its_previous_q_function():
-    agent = small_agent(ObjectCountQ(), epsilon=0.0, eval_steps=0).learn(1)
+    agent = small_agent(ObjectCountQ(), epsilon=0.0, eval_episodes=0).learn(1)
     # a greedy agent on an object count picks the same action everywhere
     with pytest.warns(RuntimeWarning, match="no transition with action"):
         agent.learn(1)
@@ -224,12 +228,13 @@ def test_missing_action_keeps_its_previous_q_function():
 def test_box_fqi_and_grid_ridge_beat_random():
     """Thesis 3.2 at small scale: 3 iterations of 5,000 samples on ObjectWorld-v0, scored
     on the 400 reference worlds (20,000 steps) against the random policy."""
-    random_score = evaluate(RandomPolicy(ENV, seed=0), ENV)
+    random_score = evaluate(RandomPolicy(ENV, seed=0), ENV, seeds=REFERENCE).total
     scores = {}
     for name, regressor in [("box", make_box_forest(ENV, n_estimators=10, random_state=0)),
                             ("grid", make_grid_ridge(ENV))]:
-        agent = FQI(regressor, ENV, samples_per_iteration=5000, eval_steps=0, seed=0)
-        scores[name] = evaluate(agent.learn(3), ENV)
+        agent = FQI(regressor, ENV, samples_per_iteration=5000, n_envs=400, eval_episodes=0,
+                    seed=0)
+        scores[name] = evaluate(agent.learn(3), ENV, seeds=REFERENCE).total
     assert random_score < -80_000
     # measured (seed 0): box about +40,000, grid about -34,000, random -95,650
     assert scores["box"] > random_score + 100_000, scores
@@ -253,17 +258,18 @@ def test_grid_observation_reuses_grid_counts():
 
 def test_train_dqn_scores_with_the_same_evaluation(tmp_path, monkeypatch):
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
-    result = train_dqn(ENV, total_timesteps=300, eval_steps=500, seed=0, learning_starts=100,
-                       policy_kwargs={"net_arch": [16]})
+    result = train_dqn(ENV, total_timesteps=300, eval_seeds=REFERENCE[:10], seed=0,
+                       learning_starts=100, policy_kwargs={"net_arch": [16]})
     assert result.model.num_timesteps == 300 and result.total_timesteps == 300
     assert np.isfinite(result.reward) and result.train_seconds > 0
-    assert result.reward == evaluate(result.policy, ENV, 500)
+    assert result.reward == evaluate(result.policy, ENV, seeds=REFERENCE[:10]).total
     assert not list(tmp_path.glob("SB3-*"))  # no stray SB3 log folder
 
 
 def test_scripted_policies_use_the_same_evaluation():
-    assert evaluate(envs.GreedyPolicy(envs.BatchedObjectWorld(1)), ENV) > 100_000
-    assert evaluate(RandomPolicy(ENV, seed=1), ENV, 1000) < 0
+    greedy = evaluate(envs.GreedyPolicy(envs.BatchedObjectWorld(1)), ENV, seeds=REFERENCE)
+    assert greedy.total > 100_000 and greedy.lengths.tolist() == [50] * 400
+    assert evaluate(RandomPolicy(ENV, seed=1), ENV, seeds=REFERENCE[:20]).total < 0
 
 
 # ---------------------------------------------------------------- bad input
@@ -279,15 +285,39 @@ def test_regressor_without_fit_predict(regressor, match):
         FQI(regressor, ENV)
 
 
-def test_env_needs_discrete_actions_and_object_world():
+def test_env_needs_discrete_actions_and_grids_need_object_sets():
     with pytest.raises(TypeError, match="Discrete action space"):
         FQI(small_forest(), gym.make("Pendulum-v1"))
-    with pytest.raises(TypeError, match="Discrete action space"):
-        GridObservation(gym.make("Pendulum-v1"))
-    with pytest.raises(TypeError, match="ObjectWorld env"):
-        FQI(small_forest(), gym.make("CartPole-v1"))
+    with pytest.raises(TypeError, match=r"object-set observations, Sequence\(Box"):
+        GridObservation(gym.make("CartPole-v1"))
     with pytest.raises(TypeError, match="env must be"):
         FQI(small_forest(), 42)
+
+
+def test_an_object_world_env_keeps_the_batched_engine_and_its_rules():
+    env = gym.make("ObjectWorldTreasure-v0", view="arrow")
+    agent = FQI(make_box_forest(env, n_estimators=2, n_tests=10), env,
+                samples_per_iteration=400, n_envs=40, eval_seeds=REFERENCE[:4])
+    for vector, n in ((agent.get_env(), 40), (agent._eval_env, 4)):
+        assert isinstance(vector, envs.BatchedObjectWorld) and vector.num_envs == n
+        assert vector.rules == env.unwrapped.rules
+    assert agent.regressor.view_bounds == (-10.0, 10.0, -10.0, 10.0)
+    assert make_grid_ridge(env)[0].n_types == 7  # arrow view: 7 types
+
+
+def test_thesis_run_is_unchanged():
+    """A small box-FQI run on the reference worlds gives, reward for reward, what it gave
+    when the agent played ObjectWorld's batched engine directly: the same training worlds,
+    drawn from the same generator, and the same action draws."""
+    forest = make_box_forest(ENV, n_estimators=5, n_tests=50, random_state=0)
+    agent = FQI(forest, ENV, samples_per_iteration=2000, n_envs=100, eval_seeds=REFERENCE[:20],
+                seed=0).learn(3)
+    assert [r["reward"] for r in agent.history] == [-1300.0, -2400.0, -1100.0]
+    assert agent.num_timesteps == 6000
+    kept = FQI(make_box_forest(ENV, n_estimators=5, n_tests=50, random_state=0), ENV,
+               samples_per_iteration=1000, n_envs=50, eval_seeds=REFERENCE[:10], seed=3,
+               keep_data=True, max_samples=2500).learn(4)
+    assert [r["reward"] for r in kept.history] == [100.0, -1200.0, 200.0, -4850.0]
 
 
 @pytest.mark.parametrize("params, error, match", [
@@ -300,8 +330,8 @@ def test_env_needs_discrete_actions_and_object_world():
     ({"gamma": 1.0}, ValueError, "gamma"),
     ({"resample_every": 0}, ValueError, "resample_every"),
     ({"keep_data": True, "max_samples": 10}, ValueError, "max_samples"),
-    ({"eval_steps": 120}, ValueError, "multiple of the episode length"),
-    ({"n_worlds": 0}, ValueError, "n_worlds"),
+    ({"eval_episodes": 1.5}, TypeError, "eval_episodes must be an int"),
+    ({"n_envs": 0}, ValueError, "n_envs"),
     ({"n_jobs": 0}, ValueError, "n_jobs"),
     ({"n_jobs": 1.5}, TypeError, "n_jobs must be an int"),
     ({"verbose": "yes"}, TypeError, "verbose must be an int or a bool"),
@@ -364,10 +394,12 @@ def _truncated_save(agent, path):
     (_truncated_save, "truncated or damaged"),
     (lambda agent, path: joblib.dump([1, 2], path), "pickle of a list, not an agent"),
     (lambda agent, path: joblib.dump({"rules": {}}, path), "pickle of a dict, not an agent"),
-    (lambda agent, path: joblib.dump({"format": 2}, path),
-     "FQI save of format version 2; this version of fqi reads version 1"),
-    (lambda agent, path: joblib.dump({"format": 1, "params": {}}, path),
-     "not an agent saved by FQI.save: it lacks history, iteration"),
+    (lambda agent, path: joblib.dump({"format": 1}, path),
+     "FQI save of format version 1; this version of fqi reads version 2"),
+    (lambda agent, path: joblib.dump({"format": 2, "state": {}}, path),
+     "not an agent saved by FQI.save: it lacks action_space, env, epsilon"),
+    (lambda agent, path: joblib.dump({"format": 2, "state": [1]}, path),
+     "not an agent saved by FQI.save: it lacks state"),
 ])
 def test_load_names_the_file_and_what_is_wrong(trained, tmp_path, write, match):
     path = tmp_path / "agent.joblib"
@@ -383,49 +415,62 @@ def test_load_of_a_missing_file_is_file_not_found(tmp_path):
 
 
 class ConstantQ(RegressorMixin, BaseEstimator):
-    """Q(s) = value everywhere, predicted `n_values` times per batch (default: one per set)."""
+    """Q(s) = value everywhere, predicted `n_values` times per batch (default: one per set);
+    with `after_rewards`, only once fitted on non-zero targets (0 before)."""
 
-    def __init__(self, value=0.0, n_values=None):
+    def __init__(self, value=0.0, n_values=None, after_rewards=False):
         self.value = value
         self.n_values = n_values
+        self.after_rewards = after_rewards
 
     def fit(self, X, y):
+        self.fitted_on_rewards_ = bool(np.any(y))
         return self
 
     def predict(self, X):
-        return np.full(len(X) if self.n_values is None else self.n_values, self.value)
+        value = self.value if self.fitted_on_rewards_ or not self.after_rewards else 0.0
+        return np.full(len(X) if self.n_values is None else self.n_values, value)
 
 
 @pytest.mark.parametrize("regressor, match", [
-    (ConstantQ(np.nan), r"predicted non-finite Q-values \(NaN or inf\) for 10 of 10"),
+    (ConstantQ(np.nan), r"predicted non-finite Q-values \(NaN or inf\) for 50 of 50"),
     (ConstantQ(np.inf), "non-finite"),
-    (ConstantQ(n_values=1), "predicted an array of size 1 for 10 observations"),
+    (ConstantQ(n_values=1), "predicted an array of size 1 for 50 observations"),
 ])
-def test_bad_predictions_stop_training_at_their_iteration(regressor, match):
-    agent = small_agent(regressor, eval_steps=500)  # evaluates 10 worlds at iteration 0
+def test_bad_predictions_are_caught_at_construction(regressor, match):
     with pytest.raises(ValueError, match=match) as excinfo:
+        small_agent(regressor)
+    assert str(excinfo.value).startswith("ConstantQ(") and "first observations" in str(
+        excinfo.value)
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf])
+def test_bad_predictions_stop_training_at_their_iteration(value):
+    regressor = ConstantQ(value, after_rewards=True)
+    agent = small_agent(regressor)  # evaluates 10 worlds at iteration 0
+    with pytest.raises(ValueError, match=r"non-finite Q-values \(NaN or inf\) for 10 of 10") \
+            as excinfo:
         agent.learn(3)
     assert str(excinfo.value).startswith("iteration 0's Q-function of action 0 (ConstantQ(")
     assert agent.history == []
-    agent = small_agent(regressor, eval_steps=0)  # first predicts while collecting, iteration 1
+    agent = small_agent(regressor, eval_episodes=0)  # first predicts collecting, iteration 1
     with pytest.raises(ValueError, match="iteration 0's Q-function of action 0"):
         agent.learn(3)
     assert len(agent.history) == 1
 
 
 def test_regressor_without_object_sets_is_told_to_wrap_them():
-    agent = small_agent(Ridge())
-    with pytest.raises(ValueError, match=r"Ridge\(\) failed on its first fit, given "
-                       r"object sets as a boxtrees.ObjectSets") as excinfo:
-        agent.learn(1)
-    message = str(excinfo.value)
-    assert "a pipeline starting with boxtrees.GridCounts" in message
-    assert isinstance(excinfo.value.__cause__, ValueError) and agent.history == []
+    with pytest.raises((TypeError, ValueError), match=r"Ridge\(\) failed to fit and predict "
+                       r"the env's observations, which FQI gives it as boxtrees.ObjectSets") \
+            as excinfo:
+        small_agent(Ridge())
+    assert "a pipeline starting with boxtrees.GridCounts" in str(excinfo.value)
+    assert excinfo.value.__cause__ is not None
 
 
 @pytest.mark.parametrize("kwargs, error, match", [
-    ({"eval_steps": 70}, ValueError, "eval_steps must be 0 or a positive multiple of the "
-                                     "episode length 50; got 70"),
+    ({"eval_episodes": -1}, ValueError, "eval_episodes must be >= 0"),
+    ({"eval_seeds": [3, -1]}, ValueError, r"eval_seeds\[1\] must be >= 0"),
     ({"total_timesteps": 0}, ValueError, "total_timesteps must be >= 1"),
     ({"gamma": float("nan")}, ValueError, r"gamma must lie in \[0.0, 1.0\]"),
     ({"seed": -1}, ValueError, "seed must be >= 0"),
@@ -450,13 +495,18 @@ def test_train_dqn_checks_every_argument_before_training(monkeypatch, kwargs, er
     (lambda: make_box_forest(test_type="square"), ValueError, "'test_type' parameter"),
     (lambda: make_box_forest(test_width=float("nan")), ValueError, "'test_width' parameter"),
     (lambda: make_box_forest(random_state=-1), ValueError, "'random_state' parameter"),
-    (lambda: make_grid_ridge(n_bins=0), ValueError, "n_bins must be >= 1"),
-    (lambda: make_grid_ridge(alpha=-1.0), ValueError, r"alpha must lie in \[0.0, inf\)"),
-    (lambda: make_grid_ridge(alpha=float("nan")), ValueError, "alpha"),
+    (lambda: make_grid_ridge(ENV, n_bins=0), ValueError, "n_bins must be >= 1"),
+    (lambda: make_grid_ridge(ENV, alpha=-1.0), ValueError, r"alpha must lie in \[0.0, inf\)"),
+    (lambda: make_grid_ridge(ENV, alpha=float("nan")), ValueError, "alpha"),
+    (lambda: make_grid_ridge(), TypeError, "needs an env observing object sets"),
+    (lambda: make_box_forest("CartPole-v1").view_bounds is None or 1 / 0, None, None),
     (lambda: RandomPolicy(ENV, seed=-1), ValueError, "seed must be >= 0"),
     (lambda: RandomPolicy(ENV, seed=True), TypeError, "seed must be an int"),
 ])
 def test_baselines_check_their_parameters(make, error, match):
+    if error is None:
+        make()
+        return
     with pytest.raises(error, match=match):
         make()
 
@@ -474,7 +524,8 @@ class ScriptedPolicy:
 @pytest.mark.parametrize("policy, error, match", [
     (object(), TypeError, "policy must have a method predict.*object has no predict"),
     (ScriptedPolicy(lambda n: (np.zeros(3, int), None)), ValueError,
-     r"returned 3 actions \(shape \(3,\)\) for a batch of 10 observations; expected 10"),
+     r"returned 3 actions \(shape \(3,\)\) for a batch of 10 observations; expected 10, "
+     r"one per env"),
     (ScriptedPolicy(lambda n: (np.full(n, 7), None)), ValueError,
      r"returned action 7; the action space is Discrete\(4\)"),
     (ScriptedPolicy(lambda n: (np.full(n, -1), None)), ValueError, "returned action -1"),
@@ -483,16 +534,19 @@ class ScriptedPolicy:
 ])
 def test_evaluate_checks_the_policy_and_its_actions(policy, error, match):
     with pytest.raises(error, match=match):
-        evaluate(policy, ENV, 500)
+        evaluate(policy, ENV, seeds=REFERENCE[:10])
 
 
-def test_evaluate_rejects_bad_step_counts():
-    with pytest.raises(ValueError, match="multiple of the episode length 50"):
-        evaluate(RandomPolicy(ENV), ENV, 1234)
-    with pytest.raises(ValueError, match="positive multiple"):
-        evaluate(RandomPolicy(ENV), ENV, 0)
-    with pytest.raises(TypeError, match="n_steps must be an int"):
-        evaluate(RandomPolicy(ENV), ENV, 500.0)
+@pytest.mark.parametrize("kwargs, error, match", [
+    ({"n_episodes": 0}, ValueError, "n_episodes must be >= 1"),
+    ({"n_episodes": 5.0}, TypeError, "n_episodes must be an int"),
+    ({"n_episodes": 2, "seeds": [1]}, ValueError, "n_episodes=2 but 1 seeds were given"),
+    ({"seeds": "0123"}, TypeError, "seeds must be a sequence of ints"),
+    ({"seeds": [0.5]}, TypeError, r"seeds\[0\] must be an int"),
+])
+def test_evaluate_rejects_bad_episode_counts_and_seeds(kwargs, error, match):
+    with pytest.raises(error, match=match):
+        evaluate(RandomPolicy(ENV), ENV, **kwargs)
 
 
 def test_transitions_concatenate_drops_unknown_next_values():
@@ -500,5 +554,6 @@ def test_transitions_concatenate_drops_unknown_next_values():
     known = _Transitions(sets, np.zeros(2, int), np.zeros(2), sets, np.zeros(2, bool),
                          np.ones(2))
     unknown = _Transitions(sets, np.zeros(2, int), np.zeros(2), sets, np.zeros(2, bool))
-    assert _Transitions.concatenate([known, known]).next_values.tolist() == [1, 1, 1, 1]
-    assert _Transitions.concatenate([known, unknown]).next_values is None
+    join = ObjectSets.concatenate
+    assert _Transitions.concatenate([known, known], join).next_values.tolist() == [1, 1, 1, 1]
+    assert _Transitions.concatenate([known, unknown], join).next_values is None

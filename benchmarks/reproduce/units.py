@@ -56,6 +56,12 @@ def _make_env(params):
     return gym.make(params["env_id"], **kwargs)
 
 
+def _reference_seeds(env, budget):
+    """The thesis's evaluation on the game's reference worlds: one episode of ``max_steps``
+    per world, ``budget.eval_steps`` steps in all."""
+    return envs.reference_worlds(budget.eval_steps // env.unwrapped.rules.max_steps)
+
+
 def _regressor(params, env, budget, seed):
     """The setting's regressor, with the budget's caps on M and K."""
     if params["model"] == "grid":
@@ -72,20 +78,25 @@ def _capped(value, cap):
 
 
 def _agent(params, budget, seed, samples):
+    """The setting's FQI agent on the game: up to 400 training worlds in lockstep (the
+    game's batched engine, through its vector entry point), evaluated on the reference
+    worlds."""
     env = _make_env(params)
     return FQI(_regressor(params, env, budget, seed), env, gamma=GAMMA,
                samples_per_iteration=samples,
                resample_every=params.get("resample_every", 1),
                keep_data=params.get("keep_data", False),
                max_samples=max(params.get("max_samples", samples), samples),
-               n_worlds=min(400, samples), eval_steps=budget.eval_steps, seed=seed)
+               n_envs=min(400, samples), eval_seeds=_reference_seeds(env, budget), seed=seed)
 
 
 def _fqi(params, budget, seed, samples):
     """Rewards per iteration (per 20,000 evaluation steps) and the random policy's."""
     agent = _agent(params, budget, seed, samples).learn(budget.iterations)
     scale = budget.reward_scale
-    random_reward = evaluate(RandomPolicy(agent.rules, seed=seed), agent.rules, budget.eval_steps)
+    env = _make_env(params)
+    random_reward = evaluate(RandomPolicy(env, seed=seed), env,
+                             seeds=_reference_seeds(env, budget)).total
     keys = ("n_samples", "nodes_per_tree", "t_collect", "t_fit", "t_evaluate", "t_total")
     return {"rewards": [r["reward"] * scale for r in agent.history],
             "random_reward": random_reward * scale,
@@ -141,7 +152,8 @@ def _dqn(params, budget, seed, samples):
     """stable-baselines3 DQN with as many env steps as one FQI run of the budget."""
     steps = budget.dqn_steps or budget.iterations * samples
     result = train_dqn(params["env_id"], total_timesteps=steps, n_bins=params["n_bins"],
-                       gamma=GAMMA, eval_steps=budget.eval_steps, seed=seed)
+                       gamma=GAMMA, eval_seeds=_reference_seeds(_make_env(params), budget),
+                       seed=seed)
     return {"reward": result.reward * budget.reward_scale, "total_timesteps": steps,
             "train_seconds": result.train_seconds, "eval_seconds": result.eval_seconds}
 
@@ -150,13 +162,14 @@ def _attention(params, budget, seed, samples):
     """A short FQI run; per action, its most informative tests and the share of test
     usage per object type, and a busy reference view to draw them on."""
     agent = _agent(params, budget, seed, samples).learn(budget.attention_iterations)
+    n_types = _make_env(params).unwrapped.n_types
     world_seed, observation = _busy_reference_view(params)
     actions = []
     for forest in agent.q_functions_:
         tests = np.concatenate([_tree_tests(tree.tree_) for tree in forest.estimators_])
         top = tests[np.argsort(-tests[:, 7])[:_TOP_TESTS]]
         usage = np.bincount(tests[:, 4].astype(int), weights=tests[:, 6],
-                            minlength=agent.rules.n_types)
+                            minlength=n_types)
         share = usage / usage.sum() if usage.sum() else usage  # a tree without tests
         actions.append({"tests": top.tolist(), "type_usage": share.tolist()})
     return {"world_seed": world_seed, "observation": observation.tolist(),
