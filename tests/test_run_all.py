@@ -6,9 +6,11 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from matplotlib.colors import to_rgb
 
+import envs
 from benchmarks.reproduce import BUDGETS, EXPERIMENTS, REGISTRY
-from benchmarks.reproduce import runner
+from benchmarks.reproduce import plots, runner
 from benchmarks.reproduce.cache import (attempts, load_unit, mark_attempt, save_unit, slug,
                                         unit_path)
 from benchmarks.reproduce.cli import main, parse_seeds
@@ -18,6 +20,7 @@ from benchmarks.reproduce.registry import Experiment, resolve
 from benchmarks.reproduce.report import figure_name, write_outputs
 from benchmarks.reproduce.runner import MAX_ATTEMPTS, gather, plan, run
 from benchmarks.reproduce.stats import SettingStats, summarise
+from envs._render import _STYLE
 
 TINY = BUDGETS["tiny"]
 
@@ -418,6 +421,15 @@ def test_report_shows_thesis_numbers_beside_ours_and_computed_verdicts(tmp_path)
     assert "Not run at this budget yet." in text  # the other experiments
     assert ("| 3.6 | [representations](#representations) | 0/10 | fixed ~ bounded > random box "
             "> grid > classic | n/a | not run at this budget yet |") in text
+
+
+def test_figures_use_the_renderers_colours_and_envs_names():
+    for kind, (colour, _, _) in _STYLE.items():  # a test box: the colour of what it tests
+        assert to_rgb(plots._TYPE_COLOURS[kind]) == pytest.approx(np.array(colour) / 255)
+    assert len(plots.TYPE_NAMES) == len(envs.TYPE_NAMES)
+    assert plots.TYPE_NAMES[envs.MONEY_MARKER] == "money marker"
+    assert plots.ACTION_NAMES == ("up", "right", "down", "left", "swipe up", "swipe right",
+                                  "swipe down", "swipe left")
 
 
 def test_budget_overrides_reach_every_setting_of_their_experiment_and_its_cache(tmp_path):

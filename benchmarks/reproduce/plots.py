@@ -10,20 +10,18 @@ from matplotlib.patches import Patch, Rectangle  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 import envs  # noqa: E402
+from envs._render import _STYLE  # noqa: E402 (envs exports no colours yet)
 
 from .stats import LAST_WINDOW  # noqa: E402
 
 __all__ = ["plot_experiment", "TYPE_NAMES", "ACTION_NAMES"]
 
-# Colours of the object types, as the env's renderer draws them (envs/_render.py).
-_TYPE_COLOURS = {envs.MONEY: "#e2b212", envs.WALL: "#64646a", envs.GRASS: "#4ca848",
-                 envs.ENEMY: "#d42c2c", envs.MONEY_MARKER: "#ff7f0e",
-                 envs.TREASURE_MARKER: "#285adc", envs.ARROW: "#8c3cc8"}
-TYPE_NAMES = {envs.MONEY: "money", envs.WALL: "wall", envs.GRASS: "grass",
-               envs.ENEMY: "enemy", envs.MONEY_MARKER: "money marker",
-               envs.TREASURE_MARKER: "treasure marker", envs.ARROW: "arrow"}
-ACTION_NAMES = ("up", "right", "down", "left", "swipe up", "swipe right", "swipe down",
-                 "swipe left")
+# The object types' colours as the renderer draws them (RGB in 0 .. 1, for matplotlib), so
+# a test box is outlined in the colour of the objects it tests in the rendered view.
+_TYPE_COLOURS = {kind: tuple(c / 255 for c in colour) for kind, (colour, _, _) in _STYLE.items()}
+# envs' names, as labels ("money marker", "swipe up")
+TYPE_NAMES = tuple(name.replace("_", " ") for name in envs.TYPE_NAMES)
+ACTION_NAMES = tuple(name.replace("_", " ") for name in envs.ACTION_NAMES)
 
 
 def plot_experiment(experiment, stats, runs, budget, path):
