@@ -5,7 +5,8 @@ finished only if its recorded parameters and budget equal the current ones, so a
 registry entry or budget re-runs the unit instead of mixing results; a file that is not a
 run record at all (damaged, or edited by hand) counts as missing too, and says so. Beside it,
 ``seed<k>.json.attempts`` counts starts that never finished (the interpreter crashed or was
-killed), so the runner can try such units last and eventually give up on them.
+killed, or the cluster worker running it died), so the runner can try such units last and
+eventually give up on them.
 """
 import json
 import os
@@ -16,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["unit_path", "load_unit", "save_unit", "slug", "attempts", "mark_attempt",
-           "reset_attempts"]
+           "set_attempts"]
 
 
 def slug(label):
@@ -227,9 +228,10 @@ def mark_attempt(path):
     _attempts_path(path).write_text(str(attempts(path) + 1))
 
 
-def reset_attempts(path, count):
-    """Set the unit's count of unfinished starts back to `count` (its start was
-    interrupted, which is no crash)."""
+def set_attempts(path, count):
+    """Set the unit's count of unfinished starts to `count`: back to the count before an
+    interrupted start (an interrupt is no crash), or up by the workers of a cluster that
+    died running the unit."""
     if count:
         _attempts_path(path).write_text(str(count))
     else:

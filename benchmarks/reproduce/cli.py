@@ -8,7 +8,7 @@ from pathlib import Path
 from .budgets import BUDGETS
 from .registry import EXPERIMENTS, REGISTRY
 from .report import write_outputs
-from .runner import MAX_ATTEMPTS, plan, run
+from .runner import MAX_ATTEMPTS, ClusterError, cluster, plan, run
 
 __all__ = ["main", "parse_seeds"]
 
@@ -64,15 +64,22 @@ def _experiments(text):
     return [REGISTRY[n] for n in names]
 
 
-def _jobs(text):
-    """``"2"`` -> 2: a whole number of parallel runs, at least 1."""
+def _count(text):
+    """``"2"`` -> 2: a whole number (of parallel runs or workers), at least 1."""
     try:
-        jobs = int(text)
+        count = int(text)
     except ValueError:
-        jobs = None
-    if jobs is None or jobs < 1:
+        count = None
+    if count is None or count < 1:
         raise argparse.ArgumentTypeError(f"expected a whole number of 1 or more, got {text!r}")
-    return jobs
+    return count
+
+
+def _address(text):
+    """A Dask scheduler's address (``tcp://host:8786`` or ``host:8786``), if not blank."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("expected a scheduler address (tcp://host:8786)")
+    return text.strip()
 
 
 def _out(text):
@@ -106,8 +113,15 @@ def _parser():
                              "the budget's")
     parser.add_argument("--out", type=_out, default="results",
                         help="output folder (default: results)")
-    parser.add_argument("--jobs", type=_jobs, default=1,
+    parser.add_argument("--jobs", type=_count, default=1,
                         help="parallel runs (default 1: each run already uses every core)")
+    dask = parser.add_mutually_exclusive_group()
+    dask.add_argument("--scheduler", type=_address, metavar="ADDRESS",
+                      help="run on the Dask cluster of this scheduler (tcp://host:8786); its "
+                           "workers need the project, the results are written here "
+                           "(docs/reproduction.md)")
+    dask.add_argument("--dask-local", type=_count, metavar="N",
+                      help="run on a Dask cluster of N worker processes on this machine")
     parser.add_argument("--report-only", action="store_true",
                         help="run nothing; rebuild figures and REPORT.md from cached runs")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -131,22 +145,28 @@ def main(argv=None):
     ------
     SystemExit
         Status 2 for an invalid argument; 130 on an interrupt; 1 if a file under ``--out``
-        cannot be written, or (after the report) if a unit was skipped for crashing
+        cannot be written, the Dask cluster cannot run the units (not reachable, or a worker
+        with other code), or (after the report) if a unit was skipped for crashing
         `MAX_ATTEMPTS` times. One line on stderr says why.
     """
     parser = _parser()
     args = parser.parse_args(argv)
+    if args.jobs > 1 and (args.scheduler or args.dask_local):
+        option = "--scheduler" if args.scheduler else "--dask-local"
+        parser.error(f"argument --jobs: not allowed with argument {option} (the cluster's "
+                     f"workers run the units)")
     budget = BUDGETS[args.budget]
     experiments = args.only or list(EXPERIMENTS)
     start = time.perf_counter()
     try:
         units = plan(experiments, budget, args.out, args.seeds)
-        done, skipped = ([], []) if args.report_only else run(units, budget, args.jobs,
-                                                              not args.no_progress)
+        done, skipped = ([], []) if args.report_only else _run(units, budget, args)
         elapsed = time.perf_counter() - start
         # a report-only invocation ran nothing: its header says so by omitting the timing
         report = write_outputs(experiments, budget, args.out, args.seeds,
                                None if args.report_only else elapsed, len(done))
+    except ClusterError as error:
+        parser.exit(1, f"{parser.prog}: error: {error}\n")
     except KeyboardInterrupt:
         parser.exit(130, f"{parser.prog}: interrupted; finished runs are cached: run the "
                          f"same command to resume\n")
@@ -161,6 +181,12 @@ def main(argv=None):
                        f"{MAX_ATTEMPTS} times (listed above); the report counts them as "
                        f"missing\n")
     return report
+
+
+def _run(units, budget, args):
+    """`run` the units here or on the cluster the arguments name."""
+    with cluster(args.scheduler, args.dask_local) as client:
+        return run(units, budget, args.jobs, not args.no_progress, client)
 
 
 def _under(filename, folder):

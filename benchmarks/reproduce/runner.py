@@ -1,18 +1,31 @@
 """The one runner: plan the (experiment, setting, seed) units, run the unfinished ones with
-a progress bar, and gather the finished ones per setting."""
+a progress bar (here, or on a Dask cluster), and gather the finished ones per setting."""
+import hashlib
+import importlib.metadata
+import logging
+import platform
 import sys
+from collections import deque
+from contextlib import contextmanager
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
-from .cache import attempts, load_unit, mark_attempt, reset_attempts, save_unit, unit_path
+import boxtrees
+import envs
+import fqi
+
+from . import units as _units
+from .cache import attempts, load_unit, mark_attempt, save_unit, set_attempts, unit_path
 from .registry import resolve
 from .stats import summarise
 from .units import run_unit
 
-__all__ = ["Unit", "plan", "run", "gather", "seeds_for", "MAX_ATTEMPTS"]
+__all__ = ["Unit", "plan", "run", "gather", "seeds_for", "cluster", "ClusterError",
+           "MAX_ATTEMPTS"]
 
 # A unit that crashed this many times is skipped (reported missing; the command fails).
 MAX_ATTEMPTS = 3
@@ -88,16 +101,31 @@ def plan(experiments, budget, out, seeds=None):
 def _execute(unit, budget):
     mark_attempt(unit.path)
     result = run_unit(unit.params, budget, unit.seed, unit.samples)
-    save_unit(unit.path, unit.params, budget, unit.samples, unit.experiment, unit.label,
-              unit.seed, result)
+    _save(unit, budget, result)
     return unit, result["seconds"]
 
 
-def run(units, budget, jobs=1, progress=True):
+def _save(unit, budget, result):
+    save_unit(unit.path, unit.params, budget, unit.samples, unit.experiment, unit.label,
+              unit.seed, result)
+
+
+def _name(unit):
+    return f"{unit.experiment}/{unit.label}/seed{unit.seed}"
+
+
+def _say_skipped(unit, crashes):
+    tqdm.write(f"skipping {_name(unit)}: it crashed {crashes} times (delete "
+               f"{unit.path}.attempts to retry)", file=sys.stderr)
+
+
+def run(units, budget, jobs=1, progress=True, client=None):
     """Run the units not already cached; show one progress bar with ETA over all of them.
 
     A unit's start counts as a crash until the unit finishes; an interrupt (Ctrl-C) takes
-    the count back, so only crashes get a unit skipped (after `MAX_ATTEMPTS` of them).
+    the count back, so only crashes get a unit skipped (after `MAX_ATTEMPTS` of them). On a
+    cluster, each worker that died running a unit is one crash of it; the unit is then
+    retried after the others, or skipped.
 
     Parameters
     ----------
@@ -105,8 +133,11 @@ def run(units, budget, jobs=1, progress=True):
     budget : Budget
     jobs : int, default=1
         Parallel processes (joblib loky). Each FQI run already uses every core for its
-        forests, so 1 is usually fastest.
+        forests, so 1 is usually fastest. Ignored with `client`.
     progress : bool, default=True
+    client : distributed.Client, default=None
+        Run the units as tasks on this Dask cluster (see `cluster`); this process writes
+        their results, so the workers need no access to the cache.
 
     Returns
     -------
@@ -114,6 +145,11 @@ def run(units, budget, jobs=1, progress=True):
         The units run now and their seconds (cached units are skipped).
     skipped : list of Unit
         The units not run because they crashed `MAX_ATTEMPTS` times.
+
+    Raises
+    ------
+    ClusterError
+        If a worker of `client` runs other code than this process (nothing is counted).
     """
     crashes = {u.path: attempts(u.path) for u in units
                if load_unit(u.path, u.params, budget, u.samples, u.seed) is None}
@@ -124,33 +160,243 @@ def run(units, budget, jobs=1, progress=True):
     cached = len(units) - len(todo)
     skipped = [u for u in todo if crashes[u.path] >= MAX_ATTEMPTS]
     for u in skipped:
-        print(f"skipping {u.experiment}/{u.label}/seed{u.seed}: it crashed {crashes[u.path]} "
-              f"times (delete {u.path}.attempts to retry)", file=sys.stderr)
+        _say_skipped(u, crashes[u.path])
     todo = todo[:len(todo) - len(skipped)]
     done = []
     with tqdm(total=sum(u.cost(budget) for u in todo), disable=not progress, unit="s",
               bar_format="{l_bar}{bar}| [{elapsed}<{remaining}]{postfix}") as bar:
         bar.set_postfix_str(f"{len(todo)} to run, {cached} cached")
-        if jobs == 1:
-            results = (_execute(u, budget) for u in todo)
-        else:
-            results = Parallel(n_jobs=jobs, return_as="generator_unordered")(
-                delayed(_execute)(u, budget) for u in todo)
+        results = _results(todo, budget, jobs, client, crashes, skipped)
         try:
             for unit, seconds in results:
                 done.append((unit, seconds))
                 bar.update(unit.cost(budget))
-                bar.set_postfix_str(f"{unit.experiment}/{unit.label}/seed{unit.seed} "
-                                    f"{seconds:.0f}s; {len(done)}/{len(todo)} run, "
-                                    f"{cached} cached")
-        except KeyboardInterrupt:
+                bar.set_postfix_str(f"{_name(unit)} {seconds:.0f}s; {len(done)}/{len(todo)} "
+                                    f"run, {cached} cached")
+        except (KeyboardInterrupt, ClusterError):  # neither is a crash of the units
             results.close()  # stops the parallel workers before their counts are reset
-            finished = {u.path for u, _ in done}
-            for u in todo:
-                if u.path not in finished and attempts(u.path) != crashes[u.path]:
-                    reset_attempts(u.path, crashes[u.path])
+            _take_back(todo, done, crashes)
             raise
     return done, skipped
+
+
+def _results(todo, budget, jobs, client, crashes, skipped):
+    """``(unit, seconds)`` of the units of `todo` as they finish: on `client`'s cluster (see
+    `_ClusterRun` for `crashes` and `skipped`), else in `jobs` processes here."""
+    if client is not None:
+        return _ClusterRun(client, budget, crashes, skipped).results(todo)
+    if jobs == 1:
+        return (_execute(u, budget) for u in todo)
+    return Parallel(n_jobs=jobs, return_as="generator_unordered")(
+        delayed(_execute)(u, budget) for u in todo)
+
+
+def _take_back(todo, done, crashes):
+    """Set the crash counts of the units of `todo` not `done` back to `crashes`: their
+    starts did not crash."""
+    finished = {u.path for u, _ in done}
+    for u in todo:
+        if u.path not in finished and attempts(u.path) != crashes[u.path]:
+            set_attempts(u.path, crashes[u.path])
+
+
+class ClusterError(RuntimeError):
+    """A Dask cluster that cannot run the units: not reachable, or a worker that runs other
+    code than this process."""
+
+
+@contextmanager
+def cluster(scheduler=None, local_workers=None):
+    """A client of a Dask cluster whose workers run the same code as this process.
+
+    Parameters
+    ----------
+    scheduler : str, default=None
+        Address of a running cluster's scheduler (``tcp://host:8786``).
+    local_workers : int, default=None
+        Else start a cluster of this many worker processes here, one unit at a time each.
+
+    Yields
+    ------
+    client : distributed.Client or None
+        None if neither argument is given (run here).
+
+    Raises
+    ------
+    ClusterError
+        If dask.distributed is not installed, the scheduler cannot be reached, or a worker
+        cannot import this project or runs another version of it or of its libraries.
+    """
+    if scheduler is None and local_workers is None:
+        yield None
+        return
+    try:
+        import distributed  # noqa: F401 (a development dependency, imported when used)
+    except ImportError:
+        raise ClusterError("running on a Dask cluster needs dask.distributed: "
+                           "pip install 'dask[distributed]'") from None
+    with (_local_client(local_workers) if local_workers is not None
+          else _remote_client(scheduler)) as client:
+        _check_workers(client)
+        yield client
+
+
+# Of the local cluster, set while it lives (it restarts dead workers): the scheduler does
+# not retry a task whose worker died, so each death reaches the runner (which retries the
+# unit last); worker processes are no daemons, or joblib inside them would run every
+# parallel loop of a unit on one thread.
+_LOCAL_CONFIG = {"distributed.scheduler.allowed-failures": 0, "distributed.worker.daemon": False}
+
+
+@contextmanager
+def _local_client(n_workers):
+    import dask
+    import distributed
+
+    with dask.config.set(_LOCAL_CONFIG), distributed.LocalCluster(
+            n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=None,
+            silence_logs=logging.ERROR) as local, distributed.Client(local) as client:
+        yield client
+
+
+def _remote_client(scheduler):
+    import distributed
+
+    try:
+        return distributed.Client(scheduler)
+    except (OSError, ValueError) as error:  # OSError includes the connection timeout
+        raise ClusterError(f"cannot reach the Dask scheduler at {scheduler}: {error}") from None
+
+
+# The libraries whose versions can change a unit's result.
+_RESULT_LIBRARIES = ("numpy", "scipy", "scikit-learn", "joblib", "gymnasium", "torch",
+                     "stable-baselines3")
+
+
+@lru_cache(maxsize=1)
+def _environment():
+    """What a unit's result depends on besides its inputs: the Python and library versions
+    and a digest of the project's sources (boxtrees, envs, fqi and the units)."""
+    environment = {"python": ".".join(platform.python_version_tuple()[:2])}
+    for name in _RESULT_LIBRARIES:
+        try:
+            environment[name] = importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:
+            environment[name] = None
+    digest = hashlib.sha256()
+    files = [p for package in (boxtrees, envs, fqi)
+             for p in sorted(Path(package.__file__).parent.iterdir())
+             if p.suffix in (".py", ".pyx", ".pxd", ".h")]
+    for path in [*files, Path(_units.__file__)]:
+        digest.update(f"{path.parent.name}/{path.name}\0".encode() + path.read_bytes())
+    environment["project sources"] = digest.hexdigest()[:12]
+    return environment
+
+
+def _mismatch(worker, theirs, ours):
+    """Why `worker`, whose `_environment` is `theirs`, may not run units for a client whose
+    `_environment` is `ours`."""
+    differences = ", ".join(f"{key} {theirs.get(key)} (here {value})"
+                            for key, value in ours.items() if theirs.get(key) != value)
+    return (f"worker {worker} differs from this machine: {differences}; install the same "
+            f"version of the project and its libraries on every worker")
+
+
+def _check_workers(client):
+    """Raise `ClusterError` unless every worker of `client` has this process's
+    `_environment`."""
+    for worker, theirs in client.run(_environment, on_error="return").items():
+        if isinstance(theirs, Exception):
+            raise ClusterError(f"worker {worker} cannot run this project's code ({theirs}); "
+                               f"install the project on every worker")
+        if theirs != _environment():
+            raise ClusterError(_mismatch(worker, theirs, _environment()))
+
+
+def _run_checked(environment, params, budget, seed, samples):
+    """`run_unit` on a worker, if the worker has the client's `environment` (a worker that
+    joined after `_check_workers` is checked here)."""
+    if _environment() != environment:
+        from distributed import get_worker
+        raise ClusterError(_mismatch(get_worker().address, _environment(), environment))
+    return run_unit(params, budget, seed, samples)
+
+
+class _ClusterRun:
+    """Units run as tasks of a Dask cluster, as many at a time as it has worker threads, so
+    a unit counts as started (`mark_attempt`) only while a worker runs it.
+
+    Parameters
+    ----------
+    client : distributed.Client
+    budget : Budget
+    crashes : dict of Path to int
+        Each unit's crash count before this run; raised for each worker that dies.
+    skipped : list of Unit
+        Where units that reach `MAX_ATTEMPTS` crashes are appended.
+    """
+
+    def __init__(self, client, budget, crashes, skipped):
+        self.client, self.budget, self.crashes, self.skipped = client, budget, crashes, skipped
+        self.environment = _environment()
+        self.queue, self.running = deque(), {}
+
+    def results(self, todo):
+        """Run `todo` in order (a unit whose worker died goes last again); write each result
+        here and yield ``(unit, seconds)`` as it finishes. On leaving early (an interrupt,
+        an error) the running tasks are cancelled."""
+        from distributed import as_completed
+
+        self.queue.extend(todo)
+        finished = as_completed()
+        try:
+            while self.queue or self.running:
+                finished.update(self._submit())
+                outcome = self._collect(next(finished))
+                if outcome is not None:
+                    yield outcome
+        finally:
+            self.client.cancel(list(self.running))
+
+    def _submit(self):
+        """Start queued units while the cluster has idle threads (at least one unit runs,
+        so a cluster without workers yet waits for them)."""
+        threads = max(1, sum(self.client.nthreads().values()))
+        futures = []
+        while self.queue and len(self.running) < threads:
+            unit = self.queue.popleft()
+            mark_attempt(unit.path)
+            future = self.client.submit(_run_checked, self.environment, unit.params,
+                                        self.budget, unit.seed, unit.samples, pure=False)
+            self.running[future] = unit
+            futures.append(future)
+        return futures
+
+    def _collect(self, future):
+        """The finished task's ``(unit, seconds)`` once written, or None if its worker died
+        (raises the unit's own error)."""
+        from distributed import KilledWorker
+
+        unit = self.running.pop(future)
+        error = future.exception() if future.status == "error" else None
+        if isinstance(error, KilledWorker):
+            # the scheduler gave up after allowed_failures + 1 workers died running it
+            self._crashed(unit, error.allowed_failures + 1)
+            return None
+        result = future.result()  # raises the unit's error, with its traceback
+        _save(unit, self.budget, result)
+        return unit, result["seconds"]
+
+    def _crashed(self, unit, deaths):
+        count = self.crashes[unit.path] = self.crashes[unit.path] + deaths
+        set_attempts(unit.path, count)
+        tqdm.write(f"{_name(unit)}: the worker running it died ({count} crash(es); "
+                   f"{MAX_ATTEMPTS} skip it)", file=sys.stderr)
+        if count >= MAX_ATTEMPTS:
+            _say_skipped(unit, count)
+            self.skipped.append(unit)
+        else:
+            self.queue.append(unit)
 
 
 def gather(experiment, budget, out, seeds=None):
