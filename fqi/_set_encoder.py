@@ -1,0 +1,91 @@
+"""`SetEncoder`: a stable-baselines3 features extractor for padded object sets."""
+import numpy as np
+import torch
+from gymnasium import spaces
+from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
+from torch import nn
+
+__all__ = ["SetEncoder"]
+
+
+class SetEncoder(BaseFeaturesExtractor):
+    """Deep Sets encoder of padded objects, with an optional masked self-attention layer.
+
+    Reads observations of shape ``(max_objects, 4)`` whose rows are ``[dx, dy, type, valid]``
+    (``envs.PaddedObjects``, or any wrapper with that layout): each valid object becomes
+    ``[dx / scale, dy / scale, one-hot type]``, goes through a shared MLP (and, with
+    ``attention``, one residual multi-head self-attention layer over the valid objects),
+    and the set is pooled by the mean and the maximum over its valid objects, then mapped
+    by an MLP to ``features_dim`` features. Padding rows take no part anywhere, so the
+    features do not depend on the padding nor on the order of the objects; an empty set
+    has all-zero pooled features.
+
+    Parameters
+    ----------
+    observation_space : gymnasium.spaces.Box
+        Of shape ``(max_objects, 4)``. The largest type id is read from the upper bound of
+        the type column and the coordinate scale from the bounds of the ``dx``, ``dy``
+        columns, so the encoder needs no knowledge of the game.
+    embed_dim : int, default=64
+        Width of the per-object MLP.
+    features_dim : int, default=128
+        Number of output features.
+    attention : bool, default=False
+        Add one masked self-attention layer between the object MLP and the pooling.
+    n_heads : int, default=4
+        Heads of the attention layer (must divide ``embed_dim``).
+
+    Examples
+    --------
+    >>> import gymnasium as gym, envs
+    >>> from stable_baselines3 import DQN
+    >>> from fqi import SetEncoder
+    >>> env = envs.PaddedObjects(gym.make("ObjectWorld-v0"), max_objects=64)
+    >>> model = DQN("MlpPolicy", env, learning_starts=0, policy_kwargs=dict(
+    ...     features_extractor_class=SetEncoder,
+    ...     features_extractor_kwargs=dict(attention=True)), seed=0).learn(64)
+    >>> model.policy.q_net.features_extractor.n_types
+    4
+    """
+
+    def __init__(self, observation_space, embed_dim=64, features_dim=128, attention=False,
+                 n_heads=4):
+        if not (isinstance(observation_space, spaces.Box) and len(observation_space.shape) == 2
+                and observation_space.shape[1] == 4):
+            raise ValueError(f"SetEncoder needs a Box observation space of shape "
+                             f"(max_objects, 4), rows [dx, dy, type, valid]; got {observation_space}")
+        for name, value in (("embed_dim", embed_dim), ("features_dim", features_dim),
+                            ("n_heads", n_heads)):
+            if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < 1:
+                raise ValueError(f"{name} must be a positive int, got {value!r}")
+        if attention and embed_dim % n_heads:
+            raise ValueError(f"n_heads ({n_heads}) must divide embed_dim ({embed_dim})")
+        super().__init__(observation_space, features_dim)
+        high, low = observation_space.high[0], observation_space.low[0]
+        self.n_types = int(high[2]) + 1
+        scale = float(np.max(np.abs([low[:2], high[:2]])))
+        self.scale = scale if np.isfinite(scale) and scale > 0 else 1.0
+        self.objects = nn.Sequential(nn.Linear(2 + self.n_types, embed_dim), nn.ReLU(),
+                                     nn.Linear(embed_dim, embed_dim), nn.ReLU())
+        self.attention = (nn.MultiheadAttention(embed_dim, n_heads, batch_first=True)
+                          if attention else None)
+        self.head = nn.Sequential(nn.Linear(2 * embed_dim, features_dim), nn.ReLU())
+
+    def forward(self, observations):
+        valid = observations[..., 3] > 0.5                          # (batch, max_objects)
+        types = observations[..., 2].round().long().clamp(0, self.n_types - 1)
+        rows = torch.cat([observations[..., :2] / self.scale,
+                          nn.functional.one_hot(types, self.n_types).float()], dim=-1)
+        hidden = self.objects(rows)
+        if self.attention is not None:
+            # a set without objects attends to nothing: let it see every row, then mask
+            ignore = ~valid & valid.any(dim=1, keepdim=True)
+            attended, _ = self.attention(hidden, hidden, hidden, key_padding_mask=ignore,
+                                         need_weights=False)
+            hidden = hidden + attended
+        mask = valid.unsqueeze(-1)
+        count = mask.sum(dim=1).clamp(min=1)
+        mean = torch.where(mask, hidden, 0.0).sum(dim=1) / count
+        largest = torch.where(mask, hidden, -torch.inf).amax(dim=1)
+        largest = torch.where(valid.any(dim=1, keepdim=True), largest, 0.0)
+        return self.head(torch.cat([mean, largest], dim=-1))
