@@ -107,9 +107,13 @@ class FQI:
         Env to evaluate on (same observation and action spaces); default: built from `env`
         like the training env, one env per episode (a vector env `env` is rebuilt from its
         spec; one without a spec needs `eval_env` or ``eval_episodes=0``).
-    n_jobs : int, default=-1
+    n_jobs : int, default=1
         Threads predicting the per-action Q-functions concurrently (at most one per
-        action; -1: one per core). The box forests release the GIL while predicting.
+        action; -1: one per core); 1 predicts them one after the other. Threads help only a
+        regressor that predicts on one core and releases the GIL: the box forests of
+        `fqi.make_box_forest` already use every core (measured: no gain), and
+        scikit-learn's forests, predicted from several threads at once, emit spurious
+        warnings about their configuration.
     log_path : str or path-like, default=None
         CSV file receiving one row per iteration (see `history` for the columns); its
         directory must exist and be writable (checked here, see `CSVLogger`).
@@ -153,7 +157,7 @@ class FQI:
 
     def __init__(self, regressor, env, gamma=0.5, epsilon=0.2, samples_per_iteration=20_000,
                  resample_every=1, keep_data=False, max_samples=100_000, n_envs=None,
-                 eval_episodes=None, eval_seeds=None, eval_env=None, n_jobs=-1,
+                 eval_episodes=None, eval_seeds=None, eval_env=None, n_jobs=1,
                  log_path=None, seed=None, verbose=0):
         self._set_params({name: value for name, value in locals().items() if name != "self"})
         world_seq, action_seq, fit_seq = np.random.SeedSequence(self.seed).spawn(3)
@@ -452,9 +456,13 @@ class FQI:
     def _q_values(self, batch):
         if self.q_functions_ is None:
             raise NotFittedError("this FQI agent has no Q-function yet; call learn() first")
-        if self._pool is None:
-            self._pool = ThreadPoolExecutor(min(effective_n_jobs(self.n_jobs), self.n_actions))
-        predictions = self._pool.map(lambda model: model.predict(batch), self.q_functions_)
+        n_threads = min(effective_n_jobs(self.n_jobs), self.n_actions)
+        if n_threads == 1:
+            predictions = [model.predict(batch) for model in self.q_functions_]
+        else:
+            if self._pool is None:
+                self._pool = ThreadPoolExecutor(n_threads)
+            predictions = self._pool.map(lambda model: model.predict(batch), self.q_functions_)
         q = np.empty((len(batch), self.n_actions))
         for action, prediction in enumerate(predictions):
             q[:, action] = _checked_prediction(

@@ -1,0 +1,41 @@
+"""benchmarks/bench_control.py end to end at a tiny budget: every agent's run, the JSON and
+the PNG, the exploration schedule, and the MushroomRL peer when it is installed."""
+import json
+
+import pytest
+
+from benchmarks import bench_control
+
+
+def test_tiny_run_writes_json_and_png(tmp_path, capsys):
+    bench_control.main(["--envs", "CartPole-v1", "--seeds", "0", "--steps", "400",
+                        "--eval-every", "200", "--no-peer", "--out", str(tmp_path)])
+    report = json.loads((tmp_path / "bench_control.json").read_text())
+    assert (tmp_path / "bench_control.png").stat().st_size > 0
+    assert {r["agent"] for r in report["runs"]} == set(bench_control.AGENTS)
+    for run in report["runs"]:
+        assert run["env_steps"] >= 400 and [s for s, _ in run["curve"]][0] >= 200
+        assert run["curve"][-1][0] == run["env_steps"] and run["steps_to_threshold"] is None
+        assert run["train_seconds"] > 0 and run["eval_seconds"] > 0
+    assert "| CartPole-v1 | fqi-box |" in report["markdown"] in capsys.readouterr().out
+
+
+def test_fqi_explores_on_the_tuned_dqn_schedule():
+    epsilon = bench_control.exploration("CartPole-v1", 100_000)  # 16 % of the steps, to 0.04
+    assert epsilon(0) == 1.0 and epsilon(8_000) == pytest.approx(0.52)
+    assert epsilon(16_000) == pytest.approx(0.04) and epsilon(90_000) == 0.04
+
+
+def test_bad_arguments(capsys):
+    with pytest.raises(SystemExit):
+        bench_control.main(["--steps", "0"])
+    assert "--steps must be >= 1" in capsys.readouterr().err
+
+
+def test_mushroom_peer_when_installed(monkeypatch):
+    pytest.importorskip("mushroom_rl")
+    monkeypatch.setattr(bench_control, "PEER_ITERATIONS", 3)
+    peer = bench_control.run_peer(seed=0, samples=300)
+    assert peer["iterations"] == 3
+    assert peer["mushroom_mean"] > 0 and peer["ours_mean"] > 0
+    assert peer["mushroom_seconds_per_iteration"] > 0 and peer["ours_seconds_per_iteration"] > 0
