@@ -228,9 +228,10 @@ class FQI:
             As in the constructor.
         """
         _check_env(env)
-        if eval_env is not None:
+        if eval_env is None:
+            eval_env = self.eval_env
+        else:
             _check_env(eval_env, "eval_env")
-            self.eval_env = eval_env
         vector = _make_vector(env, self.n_envs or _DEFAULT_ENVS)
         if isinstance(env, VectorEnv) and self.n_envs not in (None, vector.num_envs):
             raise ValueError(f"n_envs={self.n_envs} but the vector env has {vector.num_envs} "
@@ -244,23 +245,24 @@ class FQI:
             raise ValueError(f"env has the spaces {observation_space} and {action_space}; "
                              f"the agent was made for {self.observation_space} and "
                              f"{self.action_space}")
-        eval_vector = self._evaluation_env(env, vector, (observation_space, action_space))
+        eval_vector = self._evaluation_env(env, eval_env, vector,
+                                           (observation_space, action_space))
         first = _tried(vector, observations)
         self._check_regressor(observations, first)
-        self.env = env
+        self.env, self.eval_env = env, eval_env
         self._env, self._eval_env = vector, eval_vector
         self.observation_space, self.action_space = observation_space, action_space
         self.n_actions, self._observations = n_actions, observations
         self._collector = None
         self._data = None
 
-    def _evaluation_env(self, env, vector, spaces):
+    def _evaluation_env(self, env, eval_env, vector, spaces):
         """The vector env of the evaluation after each iteration (None without one)."""
         n = len(self._eval_seeds)
         if n == 0:
             return None
-        if self.eval_env is not None:
-            evaluation = _make_vector(self.eval_env, n)
+        if eval_env is not None:
+            evaluation = _make_vector(eval_env, n)
             found = (evaluation.single_observation_space, evaluation.single_action_space)
             if found != spaces:
                 raise ValueError(f"eval_env has the spaces {found[0]} and {found[1]}; env "
@@ -532,7 +534,9 @@ class FQI:
             and learns after `set_env`.
         **params
             Constructor parameters to change (``log_path``, ``n_jobs``, ``eval_seeds``...),
-            checked as by the constructor; the others keep their saved values.
+            checked as by the constructor; the others keep their saved values (a saved
+            ``log_path`` too: further iterations append to that CSV; pass
+            ``log_path=None`` to log nowhere).
 
         Returns
         -------
