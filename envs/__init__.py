@@ -21,12 +21,14 @@ from ._rules import (
 )
 from .batched import BatchedObjectWorld, RaggedBatch
 from .object_world import ObjectWorldEnv
+from .planner import LookaheadPlanner
 from .policies import GreedyPolicy
 from .wrappers import PaddedObjects, strip_padding
 
 __all__ = [
     "ObjectWorldEnv", "BatchedObjectWorld", "RaggedBatch", "WorldRules", "PaddedObjects",
     "strip_padding", "GreedyPolicy", "reference_worlds", "REFERENCE_SEED_START",
+    "LookaheadPlanner",
     "MONEY", "WALL", "GRASS", "ENEMY", "MONEY_MARKER", "TREASURE_MARKER", "ARROW",
     "TYPE_NAMES", "ACTION_NAMES", "VIEWS",
 ]

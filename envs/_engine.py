@@ -17,6 +17,7 @@ Layout. Objects that never move (money, walls, grass, treasure coins, border wal
 grid, so that a step only looks at the cells around each agent. Enemies live in dense
 ``(n_worlds, n_enemies)`` arrays; a removed object is only marked dead.
 """
+import copy
 import math
 
 import numpy as np
@@ -347,6 +348,51 @@ class _Engine:
         self.t += 1
         self.observation = self._observe(index, world)
         return rewards, self.t >= rules.max_steps
+
+    def take(self, worlds):
+        """A new engine whose world ``j`` is a copy of world ``worlds[j]``, mid-episode.
+
+        For look-ahead search. A copy holds the world's objects, enemies, agent, step count and
+        move noise, the chunks not drawn yet included: under the same actions it goes through
+        exactly the transitions the original would. Stepping a copy changes neither this
+        engine nor its generators (a copy shares them only to draw later chunks, which
+        `_draw_noise` does without moving them).
+
+        Parameters
+        ----------
+        worlds : ndarray of int of shape (k,)
+            Worlds of this engine, repeats allowed (valid ids, checked by the caller).
+
+        Returns
+        -------
+        _Engine
+        """
+        worlds = np.asarray(worlds, dtype=np.intp)
+        n, k, s = self.n_worlds, len(worlds), self._n_static
+        new = copy.copy(self)  # the rules and what only depends on them are shared
+        new.n_worlds = k
+        names = ["_x", "_y", "_types", "_alive"]
+        names += ["_minimap_cell"] if self.rules.view == "minimap" else []
+        for name in names:  # flat, world after world
+            setattr(new, name, getattr(self, name).reshape(n, s)[worlds].ravel())
+        n_cells = self._grid ** 2
+        own_start = self._cell_start[:-1].reshape(n, n_cells) - s * np.arange(n)[:, None]
+        new._cell_start = np.append((own_start[worlds] + s * np.arange(k)[:, None]).ravel(),
+                                    k * s)
+        names = ["_ex", "_ey", "_enemy_alive", "agent", "_treasure", "_noise"]
+        names += ["_cell_money", "_visited"] if self.rules.view == "minimap" else []
+        for name in names:  # one row per world
+            setattr(new, name, getattr(self, name)[worlds])
+        new._rngs = [self._rngs[i] for i in worlds]
+        if self._noise_states is not None:  # _draw_noise replaces these dicts, never edits them
+            new._noise_states = [self._noise_states[i] for i in worlds]
+        data, offsets = self.observation
+        sizes = np.diff(offsets)[worlds]
+        new_offsets = np.zeros(k + 1, dtype=np.intp)
+        np.cumsum(sizes, out=new_offsets[1:])
+        rows = np.repeat(offsets[worlds] - new_offsets[:-1], sizes) + np.arange(new_offsets[-1])
+        new.observation = (data[rows], new_offsets)
+        return new
 
     # ----------------------------------------------------------------------------------
     def _draw_noise(self):
