@@ -577,9 +577,10 @@ def test_an_interrupted_cluster_run_is_no_crash(dask_client, tmp_path, monkeypat
 
 @pytest.mark.parametrize("environment, problem", [
     (_other_numpy, r"differs from this machine: numpy 0\.0 \(here [0-9.]+\); install the "
-                   r"same version of the project and its libraries on every worker"),
+                   r"same version of the project and its libraries on the scheduler and "
+                   r"every worker"),
     (_no_project, r"cannot run this project's code \(No module named 'boxtrees'\); install "
-                  r"the project on every worker"),
+                  r"the project on the scheduler and every worker"),
 ], ids=["other numpy", "no project"])
 def test_workers_with_other_code_are_refused(dask_client, tmp_path, environment, problem):
     units = plan([REGISTRY["sampling"]], TINY, tmp_path, seeds=[0])

@@ -8,7 +8,6 @@ import sys
 from collections import deque
 from contextlib import contextmanager
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 
 from joblib import Parallel, delayed
@@ -224,8 +223,9 @@ def cluster(scheduler=None, local_workers=None):
     Raises
     ------
     ClusterError
-        If dask.distributed is not installed, the scheduler cannot be reached, or a worker
-        cannot import this project or runs another version of it or of its libraries.
+        If dask.distributed is not installed, the scheduler cannot be reached, or it or a
+        worker cannot import this project or has another version of it or of its
+        libraries.
     """
     if scheduler is None and local_workers is None:
         yield None
@@ -237,7 +237,7 @@ def cluster(scheduler=None, local_workers=None):
                            "pip install 'dask[distributed]'") from None
     with (_local_client(local_workers) if local_workers is not None
           else _remote_client(scheduler)) as client:
-        _check_workers(client)
+        _check_cluster(client)
         yield client
 
 
@@ -273,8 +273,7 @@ _RESULT_LIBRARIES = ("numpy", "scipy", "scikit-learn", "joblib", "gymnasium", "t
                      "stable-baselines3")
 
 
-@lru_cache(maxsize=1)
-def _environment():
+def _describe_environment():
     """What a unit's result depends on besides its inputs: the Python and library versions
     and a digest of the project's sources (boxtrees, envs, fqi and the units)."""
     environment = {"python": ".".join(platform.python_version_tuple()[:2])}
@@ -293,32 +292,49 @@ def _environment():
     return environment
 
 
-def _mismatch(worker, theirs, ours):
-    """Why `worker`, whose `_environment` is `theirs`, may not run units for a client whose
-    `_environment` is `ours`."""
+# Described on import, next to importing the project: the code this process runs (its
+# files may change later).
+_ENVIRONMENT = _describe_environment()
+
+
+def _environment():
+    """This process's `_describe_environment` (run on the scheduler and the workers)."""
+    return _ENVIRONMENT
+
+
+def _mismatch(name, theirs, ours):
+    """Why `name` (the scheduler or a worker), whose `_environment` is `theirs`, may not
+    serve a client whose `_environment` is `ours`."""
     differences = ", ".join(f"{key} {theirs.get(key)} (here {value})"
                             for key, value in ours.items() if theirs.get(key) != value)
-    return (f"worker {worker} differs from this machine: {differences}; install the same "
-            f"version of the project and its libraries on every worker")
+    return (f"{name} differs from this machine: {differences}; install the same version of "
+            f"the project and its libraries on the scheduler and every worker")
 
 
-def _check_workers(client):
-    """Raise `ClusterError` unless every worker of `client` has this process's
-    `_environment`."""
-    for worker, theirs in client.run(_environment, on_error="return").items():
+def _check_cluster(client):
+    """Raise `ClusterError` unless the scheduler (it unpickles the tasks) and every worker
+    of `client` have this process's `_environment`."""
+    try:
+        found = {"the scheduler": client.run_on_scheduler(_environment)}
+    except Exception as error:  # whatever the scheduler met importing or running it
+        found = {"the scheduler": error}
+    found.update((f"worker {worker}", theirs)
+                 for worker, theirs in client.run(_environment, on_error="return").items())
+    for name, theirs in found.items():
         if isinstance(theirs, Exception):
-            raise ClusterError(f"worker {worker} cannot run this project's code ({theirs}); "
-                               f"install the project on every worker")
+            raise ClusterError(f"{name} cannot run this project's code ({theirs}); install "
+                               f"the project on the scheduler and every worker")
         if theirs != _environment():
-            raise ClusterError(_mismatch(worker, theirs, _environment()))
+            raise ClusterError(_mismatch(name, theirs, _environment()))
 
 
 def _run_checked(environment, params, budget, seed, samples):
     """`run_unit` on a worker, if the worker has the client's `environment` (a worker that
-    joined after `_check_workers` is checked here)."""
+    joined after `_check_cluster` is checked here)."""
     if _environment() != environment:
         from distributed import get_worker
-        raise ClusterError(_mismatch(get_worker().address, _environment(), environment))
+        raise ClusterError(_mismatch(f"worker {get_worker().address}", _environment(),
+                                     environment))
     return run_unit(params, budget, seed, samples)
 
 
