@@ -8,7 +8,9 @@ plus the baselines of the thesis.
   with a ``predict`` method (`RandomPolicy`, DQN, `FQI`);
 - baselines: `make_box_forest` (thesis parameters; ``test_type="classic"``),
   `make_grid_ridge` (``GridCounts`` + ``Ridge``), `GridObservation` (a fixed-size
-  observation wrapper) and `train_dqn` (stable-baselines3 DQN on it).
+  observation wrapper), `train_dqn` (stable-baselines3 DQN on it) and `SetEncoder` (a
+  stable-baselines3 features extractor for padded object sets; imported on first use, as it
+  needs torch).
 
 `fqi` talks to its env through gymnasium's API only and knows no particular game.
 """
@@ -19,4 +21,13 @@ from ._logger import CSVLogger
 from ._wrappers import GridObservation
 
 __all__ = ["FQI", "evaluate", "Evaluation", "RandomPolicy", "GridObservation",
-           "make_box_forest", "make_grid_ridge", "train_dqn", "DQNResult", "CSVLogger"]
+           "make_box_forest", "make_grid_ridge", "train_dqn", "DQNResult", "CSVLogger",
+           "SetEncoder"]
+
+
+def __getattr__(name):
+    if name == "SetEncoder":    # torch is imported only by those who use it
+        from ._set_encoder import SetEncoder
+
+        return SetEncoder
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

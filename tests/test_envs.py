@@ -1,6 +1,5 @@
 """The ObjectWorld rules, the gymnasium API, rendering, wrappers and bad input."""
 import copy
-import doctest
 import hashlib
 import tracemalloc
 
@@ -483,10 +482,6 @@ def test_greedy_policy_beats_random_play():
     assert policy.predict(obs)[0] == policy.predict(worlds.reset(seed=100)[0])[0][0]
 
 
-@pytest.mark.parametrize("module", [envs.object_world, envs.batched, envs.wrappers,
-                                    envs.policies])
-def test_docstring_examples_run(module):
-    assert doctest.testmod(module).failed == 0
 
 
 # --------------------------------------------------------------------------- bad input

@@ -1,6 +1,5 @@
 """`LookaheadPlanner`: beats the greedy heuristic, is exact and deterministic, leaves the
 world alone; the engine's copies of worlds; its leg model; bad input."""
-import doctest
 import itertools
 
 import gymnasium as gym
@@ -186,7 +185,3 @@ def test_act_needs_a_reset_objectworld_mid_episode():
     planner.play(worlds, seed=0)
     with pytest.raises(RuntimeError, match="the episode is over"):
         planner.act(worlds)
-
-
-def test_docstring_examples_run():
-    assert doctest.testmod(envs.planner).failed == 0

@@ -6,7 +6,7 @@ import pytest
 torch = pytest.importorskip("torch")
 
 import envs  # noqa: E402  (registers the game)
-from fqi._set_encoder import SetEncoder  # noqa: E402
+from fqi import SetEncoder  # noqa: E402
 
 
 def padded_env(max_objects=48):
