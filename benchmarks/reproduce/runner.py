@@ -200,13 +200,13 @@ def _take_back(todo, done, crashes):
 
 
 class ClusterError(RuntimeError):
-    """A Dask cluster that cannot run the units: not reachable, or a worker that runs other
-    code than this process."""
+    """A Dask cluster that cannot run the units: not reachable, or its scheduler or a worker
+    has other code than this process."""
 
 
 @contextmanager
 def cluster(scheduler=None, local_workers=None):
-    """A client of a Dask cluster whose workers run the same code as this process.
+    """A client of a Dask cluster whose scheduler and workers have this process's code.
 
     Parameters
     ----------
