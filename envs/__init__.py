@@ -19,6 +19,7 @@ from ._rules import (
     ACTION_NAMES, ARROW, ENEMY, GRASS, MONEY, MONEY_MARKER, REFERENCE_SEED_START,
     TREASURE_MARKER, TYPE_NAMES, VIEWS, WALL, WorldRules, reference_worlds,
 )
+from ._render import TYPE_COLOURS
 from .batched import BatchedObjectWorld, RaggedBatch
 from .object_world import ObjectWorldEnv
 from .planner import LookaheadPlanner
@@ -30,7 +31,7 @@ __all__ = [
     "strip_padding", "GreedyPolicy", "reference_worlds", "REFERENCE_SEED_START",
     "LookaheadPlanner",
     "MONEY", "WALL", "GRASS", "ENEMY", "MONEY_MARKER", "TREASURE_MARKER", "ARROW",
-    "TYPE_NAMES", "ACTION_NAMES", "VIEWS",
+    "TYPE_NAMES", "TYPE_COLOURS", "ACTION_NAMES", "VIEWS",
 ]
 
 _ENTRY_POINTS = {"entry_point": "envs.object_world:ObjectWorldEnv",

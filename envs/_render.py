@@ -9,14 +9,24 @@ _BACKGROUND = (245, 240, 226)
 _VIEW_COLOUR = (40, 60, 140)
 _AGENT = ((20, 20, 20), "disc", 0.55)
 # Per type: colour, shape, radius in world units.
+# RGB colour of each object type, as drawn (and as the benchmark figures show it)
+TYPE_COLOURS = {
+    MONEY: (226, 178, 18),
+    WALL: (100, 100, 106),
+    GRASS: (76, 168, 72),
+    ENEMY: (212, 44, 44),
+    MONEY_MARKER: (212, 44, 44),
+    TREASURE_MARKER: (40, 90, 220),
+    ARROW: (140, 60, 200),
+}
+# the sprite of each type: colour, shape, radius in units
 _STYLE = {
-    MONEY: ((226, 178, 18), "disc", 0.45),
-    WALL: ((100, 100, 106), "square", 0.5),
-    GRASS: ((76, 168, 72), "triangle", 0.45),
-    ENEMY: ((212, 44, 44), "diamond", 0.55),
-    MONEY_MARKER: ((212, 44, 44), "ring", 0.9),
-    TREASURE_MARKER: ((40, 90, 220), "diamond", 0.9),
-    ARROW: ((140, 60, 200), "plus", 0.7),
+    kind: (TYPE_COLOURS[kind], shape, radius)
+    for kind, shape, radius in [
+        (MONEY, "disc", 0.45), (WALL, "square", 0.5), (GRASS, "triangle", 0.45),
+        (ENEMY, "diamond", 0.55), (MONEY_MARKER, "ring", 0.9),
+        (TREASURE_MARKER, "diamond", 0.9), (ARROW, "plus", 0.7),
+    ]
 }
 _DRAW_ORDER = (GRASS, WALL, MONEY, ENEMY, MONEY_MARKER, TREASURE_MARKER, ARROW)
 _WORLD_SCALE = 8.0  # pixels per unit when drawing the whole world

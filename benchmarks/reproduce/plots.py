@@ -10,7 +10,6 @@ from matplotlib.patches import Patch, Rectangle  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 import envs  # noqa: E402
-from envs._render import _STYLE  # noqa: E402 (envs exports no colours yet)
 
 from .stats import LAST_WINDOW  # noqa: E402
 
@@ -18,7 +17,7 @@ __all__ = ["plot_experiment", "TYPE_NAMES", "ACTION_NAMES"]
 
 # The object types' colours as the renderer draws them (RGB in 0 .. 1, for matplotlib), so
 # a test box is outlined in the colour of the objects it tests in the rendered view.
-_TYPE_COLOURS = {kind: tuple(c / 255 for c in colour) for kind, (colour, _, _) in _STYLE.items()}
+_TYPE_COLOURS = {kind: tuple(c / 255 for c in rgb) for kind, rgb in envs.TYPE_COLOURS.items()}
 # envs' names, as labels ("money marker", "swipe up")
 TYPE_NAMES = tuple(name.replace("_", " ") for name in envs.TYPE_NAMES)
 ACTION_NAMES = tuple(name.replace("_", " ") for name in envs.ACTION_NAMES)
