@@ -6,7 +6,9 @@ iteration), evaluated after every iteration by the total greedy reward over 20,0
 the 400 reference worlds. Further runs (``--runs``) use the same budget: the thesis's
 "mixed" regime (``box-mixed``), kept data (``box-keep``), offline FQI (``box-offline``),
 grid + ridge (``grid-ridge``), classic trees (``classic``) and stable-baselines3 DQN on the
-10x10 grid observation with as many env steps (``dqn``, ``--dqn-steps``).
+10x10 grid observation with as many env steps (``dqn``, ``--dqn-steps``). Every FQI run is a
+setting of the experiment registry (``benchmarks/reproduce/registry.py``), built as
+``run_all.py`` builds it, so the two cannot drift apart.
 
 Prints the phase times of every iteration and a summary, writes ``bench_fqi.json`` and the
 reward curves ``bench_fqi.png`` under ``--out``.
@@ -18,35 +20,40 @@ reward curves ``bench_fqi.png`` under ``--out``.
 import argparse
 import json
 import platform
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-import envs
-from fqi import (FQI, RandomPolicy, evaluate, make_box_forest, make_grid_ridge,
-                 train_dqn)
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import envs  # noqa: E402
+from benchmarks.reproduce.budgets import BUDGETS  # noqa: E402
+from benchmarks.reproduce.registry import REGISTRY  # noqa: E402
+from benchmarks.reproduce.units import make_agent  # noqa: E402
+from fqi import RandomPolicy, evaluate, train_dqn  # noqa: E402
 
 ENV = "ObjectWorld-v0"
 REFERENCE_WORLDS = envs.reference_worlds(400)  # the thesis's 400 evaluation episodes of 50 steps
-N_WORLDS = 400  # training worlds in lockstep (the game's batched engine)
 PHASES = ("t_collect", "t_targets", "t_fit", "t_evaluate")
+# each run: (experiment, setting) of the registry, and what it changes on top of it
 FQI_RUNS = {
-    "box": (lambda: make_box_forest(ENV), {}),
-    "box-mixed": (lambda: make_box_forest(ENV), {"resample_every": 5}),
-    "box-keep": (lambda: make_box_forest(ENV), {"keep_data": True, "max_samples": 100_000}),
-    "box-offline": (lambda: make_box_forest(ENV), {"resample_every": None}),
-    "grid-ridge": (lambda: make_grid_ridge(ENV), {}),
-    "classic": (lambda: make_box_forest(ENV, test_type="classic"), {}),
+    "box": ("representations", "fixed TW=1", {}),
+    "box-mixed": ("sampling", "mixed (every 5)", {}),
+    "box-keep": ("keep_data", "keep data (100k)", {}),
+    "box-offline": ("representations", "fixed TW=1", {"resample_every": None}),
+    "grid-ridge": ("representations", "grid 10 + ridge", {}),
+    "classic": ("representations", "classic", {}),
 }
 THESIS_LEVEL, HUMAN_LEVEL = 100_000, 150_000
 
 
 def run_fqi(name, iterations, samples, seed):
     """One FQI run; returns its summary with the per-iteration records."""
-    make_regressor, params = FQI_RUNS[name]
-    agent = FQI(make_regressor(), ENV, samples_per_iteration=samples, n_envs=N_WORLDS,
-                eval_seeds=REFERENCE_WORLDS, seed=seed, **params)
+    experiment, label, changes = FQI_RUNS[name]
+    params = {**REGISTRY[experiment].params(label), **changes}
+    agent = make_agent(params, BUDGETS["full"], seed, samples)
     print(f"\n== {name}: {agent!r}")
     print(f"{'it':>3} {'reward':>10} {'samples':>8} {'nodes/tree':>10} "
           + " ".join(f"{p[2:]:>9}" for p in PHASES) + f" {'total':>7}")

@@ -9,30 +9,44 @@ reference worlds) over its last 5 iterations.
     python benchmarks/sweep_fqi.py regime [--values normal mixed keep offline] [--seeds 0 1]
         [--iterations 10] [--samples 10000] [--trees 10] [--out results]
 
-The gamma sweep runs the "normal" regime; the regime sweep uses FQI's default gamma.
-Writes ``sweep_fqi_<what>.json`` under ``--out``.
+The gamma sweep runs the "normal" regime; the regime sweep uses the harness's gamma (0.5).
+Each regime is a setting of the experiment registry (``benchmarks/reproduce/registry.py``),
+built as ``run_all.py`` builds it, with ``--trees`` trees. Writes ``sweep_fqi_<what>.json``
+under ``--out``.
 """
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-import envs
-from fqi import FQI, make_box_forest
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.reproduce.budgets import BUDGETS  # noqa: E402
+from benchmarks.reproduce.registry import REGISTRY  # noqa: E402
+from benchmarks.reproduce.units import make_agent  # noqa: E402
 
 ENV = "ObjectWorld-v0"
+# each regime: (experiment, setting) of the registry, and what it changes on top of it
 REGIMES = {
-    "normal": {"resample_every": 1},
-    "mixed": {"resample_every": 5},
-    "keep": {"keep_data": True, "max_samples": 100_000},
-    "offline": {"resample_every": None},
+    "normal": ("sampling", "normal", {}),
+    "mixed": ("sampling", "mixed (every 5)", {}),
+    "keep": ("keep_data", "keep data (100k)", {}),
+    "offline": ("sampling", "normal", {"resample_every": None}),
 }
 SWEEPS = {
-    "gamma": (["0.5", "0.8", "0.9", "0.95"], lambda value: {"gamma": float(value)}),
+    "gamma": (["0.5", "0.8", "0.9", "0.95"], lambda value: ("sampling", "normal",
+                                                           {"gamma": float(value)})),
     "regime": (list(REGIMES), lambda value: REGIMES[value]),
 }
+
+
+def _params(setting, trees):
+    """A registry setting's parameters with its changes and ``trees`` trees."""
+    experiment, label, changes = setting
+    return {**REGISTRY[experiment].params(label), **changes, "n_estimators": trees}
 
 
 def main():
@@ -53,9 +67,8 @@ def main():
     for value in values:
         for seed in args.seeds:
             start = time.perf_counter()
-            agent = FQI(make_box_forest(ENV, n_estimators=args.trees), ENV,
-                        samples_per_iteration=args.samples, n_envs=400,
-                        eval_seeds=envs.reference_worlds(400), seed=seed, **settings(value))
+            agent = make_agent(_params(settings(value), args.trees), BUDGETS["full"], seed,
+                               args.samples)
             curve = [r["reward"] for r in agent.learn(args.iterations).history]
             seconds = time.perf_counter() - start
             last = float(np.mean(curve[-5:]))

@@ -606,3 +606,15 @@ def test_a_worker_that_dies_is_a_crash_of_its_unit(dask_client, tmp_path, capsys
         f"{name}: the worker running it died (2 crash(es); 3 skip it)",
         f"{name}: the worker running it died (3 crash(es); 3 skip it)",
         f"skipping {name}: it crashed 3 times (delete {mixed.path}.attempts to retry)"]
+
+
+def test_bench_fqi_and_sweep_fqi_runs_are_registry_settings():
+    """The thesis-scale benchmark and the sweeps build their agents from the registry."""
+    from benchmarks import bench_fqi, sweep_fqi
+    from benchmarks.reproduce.registry import REGISTRY
+
+    for experiment, label, changes in [*bench_fqi.FQI_RUNS.values(), *sweep_fqi.REGIMES.values()]:
+        params = REGISTRY[experiment].params(label)
+        assert params["kind"] == "fqi" and set(changes) <= {"resample_every", "gamma"}
+    assert sweep_fqi._params(sweep_fqi.REGIMES["offline"], 10)["resample_every"] is None
+    assert sweep_fqi._params(sweep_fqi.REGIMES["keep"], 10)["n_estimators"] == 10

@@ -14,7 +14,7 @@ import envs
 from boxtrees import ObjectSets
 from fqi import FQI, RandomPolicy, evaluate, make_box_forest, make_grid_ridge, train_dqn
 
-__all__ = ["run_unit", "GAMMA"]
+__all__ = ["run_unit", "make_agent", "GAMMA"]
 
 # Discount factor of every FQI and DQN run (the thesis does not state one; 0.5 scored best
 # in the measured comparison of README section "fqi"). Pinned here so a changed library
@@ -77,12 +77,27 @@ def _capped(value, cap):
     return value if cap is None else min(value, cap)
 
 
-def _agent(params, budget, seed, samples):
-    """The setting's FQI agent on the game: up to 400 training worlds in lockstep (the
-    game's batched engine, through its vector entry point), evaluated on the reference
-    worlds."""
+def make_agent(params, budget, seed, samples):
+    """The FQI agent of a registry setting on the game: up to 400 training worlds in
+    lockstep (the game's batched engine, through its vector entry point), evaluated on the
+    reference worlds.
+
+    Parameters
+    ----------
+    params : dict
+        A setting's parameters (`Experiment.params`); ``gamma`` may override `GAMMA`.
+    budget : reproduce.budgets.Budget
+        Its caps on trees and tests, and its evaluation steps.
+    seed : int
+    samples : int
+        Samples per iteration.
+
+    Returns
+    -------
+    agent : fqi.FQI
+    """
     env = _make_env(params)
-    return FQI(_regressor(params, env, budget, seed), env, gamma=GAMMA,
+    return FQI(_regressor(params, env, budget, seed), env, gamma=params.get("gamma", GAMMA),
                samples_per_iteration=samples,
                resample_every=params.get("resample_every", 1),
                keep_data=params.get("keep_data", False),
@@ -92,7 +107,7 @@ def _agent(params, budget, seed, samples):
 
 def _fqi(params, budget, seed, samples):
     """Rewards per iteration (per 20,000 evaluation steps) and the random policy's."""
-    agent = _agent(params, budget, seed, samples).learn(budget.iterations)
+    agent = make_agent(params, budget, seed, samples).learn(budget.iterations)
     scale = budget.reward_scale
     env = _make_env(params)
     random_reward = evaluate(RandomPolicy(env, seed=seed), env,
@@ -161,7 +176,7 @@ def _dqn(params, budget, seed, samples):
 def _attention(params, budget, seed, samples):
     """A short FQI run; per action, its most informative tests and the share of test
     usage per object type, and a busy reference view to draw them on."""
-    agent = _agent(params, budget, seed, samples).learn(budget.attention_iterations)
+    agent = make_agent(params, budget, seed, samples).learn(budget.attention_iterations)
     n_types = _make_env(params).unwrapped.n_types
     world_seed, observation = _busy_reference_view(params)
     actions = []
