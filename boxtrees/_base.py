@@ -228,9 +228,13 @@ class ClassificationTargets(ClassifierMixin):
         if value.ndim == 1:         # the single indicator of a binary output: p(class 1)
             value = np.column_stack([1.0 - value, value])
         arrays["value"] = value
-        blocks = np.split(value, np.cumsum(np.atleast_1d(self.n_classes_))[:-1], axis=1)
-        arrays["impurity"] = np.mean([1.0 - (b * b).sum(axis=1) for b in blocks], axis=0)
+        arrays["impurity"] = np.mean([1.0 - (b * b).sum(axis=1) for b in self._per_output(value)],
+                                     axis=0)
         return arrays
+
+    def _per_output(self, values):
+        """Split class-frequency columns into one block per output."""
+        return np.split(values, np.cumsum(np.atleast_1d(self.n_classes_))[:-1], axis=1)
 
     def predict_proba(self, X):
         """Class probabilities: the mean over the trees of the leaves' class frequencies.
@@ -244,8 +248,7 @@ class ClassificationTargets(ClassifierMixin):
         proba : ndarray of shape (n_samples, n_classes_), or a list of them per output
             Columns in the order of ``classes_``.
         """
-        values = self._predict_mean(X, getattr(self, "n_jobs", None))
-        blocks = np.split(values, np.cumsum(np.atleast_1d(self.n_classes_))[:-1], axis=1)
+        blocks = self._per_output(self._predict_mean(X, getattr(self, "n_jobs", None)))
         return blocks[0] if self.n_outputs_ == 1 else blocks
 
     def predict_log_proba(self, X):
