@@ -280,7 +280,26 @@ def test_every_experiment_runs_end_to_end(tiny_run):
     assert len(rmse["fold_rmse"]) == TINY.rmse_folds and len(rmse["action_rmse"]) == 4
     attention = json.loads(unit_path(out, TINY, "attention", "bounded TW=4", 0).read_text())
     assert len(attention["result"]["actions"]) == 4
-    assert all(len(t) == 8 for a in attention["result"]["actions"] for t in a["tests"])
+    assert all(len(t) == 9 for a in attention["result"]["actions"] for t in a["tests"])
+    # the tests of every type a forest tests are drawn, each with the sign of its effect
+    for action in attention["result"]["actions"]:
+        drawn = {int(t[4]) for t in action["tests"]}
+        assert drawn == {t for t, share in enumerate(action["type_usage"]) if share > 0}
+
+
+def test_a_test_effect_is_the_right_child_minus_the_left():
+    from benchmarks.reproduce.units import _tree_tests
+    from boxtrees import BoxExtraTreesRegressor
+
+    rng = np.random.default_rng(0)
+    X = [np.column_stack([rng.uniform(-3, 3, (4, 2)), rng.integers(0, 2, 4)]) for _ in range(300)]
+    # more objects of type 0 near the origin: a higher target (they attract)
+    y = [float(((np.abs(s[:, :2]).max(1) < 1) & (s[:, 2] == 0)).sum()) for s in X]
+    tree = BoxExtraTreesRegressor(1, n_tests=50, min_samples_split=10, random_state=0).fit(X, y)[0].tree_
+    rows = _tree_tests(tree)
+    root = rows[0]
+    assert root[8] == tree.value[tree.children_right[0]] - tree.value[tree.children_left[0]]
+    assert root[4] == 0 and root[8] > 0
 
 
 def test_second_invocation_reuses_the_cache_and_resumes(tiny_run):

@@ -77,7 +77,7 @@ def _record_shape(kind, budget):
         "rmse": {"fold_rmse": _ListOf(float, budget.rmse_folds)},
         "dqn": {"reward": float},
         "attention": {"world_seed": int, "reward": float, "q_values": _ListOf(float),
-                      "actions": _ListOf({"tests": _ListOf(_ListOf(float, 8)),
+                      "actions": _ListOf({"tests": _ListOf(_ListOf(float, 9)),
                                           "type_usage": _ListOf(float)})},
     }[kind]
     return {"seed": int, "result": {"seconds": float, **result}}

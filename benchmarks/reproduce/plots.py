@@ -109,8 +109,9 @@ def _dqn(experiment, stats, runs, budget):
 
 
 def _attention(experiment, stats, runs, budget):
-    """Per action, the most informative test boxes of the Q-forest (outline colour: the
-    tested type; line width: the test's weighted variance reduction) over the local view of
+    """Per action, the most informative test boxes of the Q-forest on every object type
+    (outline colour: the tested type; solid when more objects in the box raise Q, dashed when
+    they lower it; line width: the test's weighted variance reduction) over the local view of
     a reference world the agent never trained on."""
     (label, records), = runs.items()
     result = records[0]["result"]
@@ -127,10 +128,11 @@ def _attention(experiment, stats, runs, budget):
     strongest = max((t[7] for a in result["actions"] for t in a["tests"]), default=1.0) or 1.0
     for action, (ax, info) in enumerate(zip(axes.flat, result["actions"])):
         ax.imshow(image, extent=(-extent, extent, -extent, extent))
-        for xmin, xmax, ymin, ymax, kind, threshold, _, reduction in info["tests"]:
+        for xmin, xmax, ymin, ymax, kind, threshold, _, reduction, effect in info["tests"]:
             box = np.clip([xmin, xmax, ymin, ymax], -extent, extent)
             ax.add_patch(Rectangle((box[0], box[2]), box[1] - box[0], box[3] - box[2],
                                    fill=False, lw=0.6 + 3.0 * reduction / strongest,
+                                   ls="-" if effect > 0 else "--",
                                    edgecolor=_TYPE_COLOURS[int(kind)]))
         top = np.argsort(info["type_usage"])[::-1][:2]
         usage = ", ".join(f"{TYPE_NAMES[t]} {info['type_usage'][t]:.0%}" for t in top)
@@ -142,7 +144,11 @@ def _attention(experiment, stats, runs, budget):
         ax.axis("off")
     types = sorted({int(t[4]) for a in result["actions"] for t in a["tests"]})
     fig.legend(handles=[Patch(edgecolor=_TYPE_COLOURS[t], fill=False, label=TYPE_NAMES[t])
-                        for t in types], loc="lower center", ncol=len(types), fontsize=8)
+                        for t in types]
+               + [Patch(edgecolor="black", fill=False, ls=ls, label=what)
+                  for ls, what in (("-", "attracts (more objects, higher Q)"),
+                                   ("--", "repels (more objects, lower Q)"))],
+               loc="lower center", ncol=len(types) + 2, fontsize=8)
     fig.suptitle(f"Most informative tests per action, {label} Q-forest after "
                  f"{budget.attention_iterations} iterations ({budget.name} budget)", fontsize=10)
     return fig
