@@ -246,13 +246,13 @@ cdef class _Splitter:
         Tests are drawn on every type of the training set, or with node-local ranges (feature
         matrices) on the columns that are not constant in the node.
         """
-        cdef intp_t ty, g
+        cdef intp_t ty, g, k
         cdef double* r
         self.start = start
         self.end = end
         self.w_sum = w_sum
-        for ty in range(self.n_outputs):
-            self.wy_sum[ty] = wy_sum[ty]
+        for k in range(self.n_outputs):
+            self.wy_sum[k] = wy_sum[k]
         # A proxy is at most sum(w y^2); differences below this are summation-order noise,
         # and the test drawn first wins them, so equal data in another order or as repeated
         # rows instead of integer weights gives the same tree.
