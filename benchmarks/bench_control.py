@@ -11,8 +11,8 @@ seed. Every ``--eval-every`` steps the greedy policy plays one episode on each o
 held-out reset seeds (`fqi.evaluate`, the same for every agent). Reported per run: the
 mean return at the end of the budget, the environment steps at the first evaluation whose
 mean reaches the env's solved threshold (CartPole 475, Acrobot -100, MountainCar -110),
-and the wall time of training (evaluations excluded; one core per agent: single-job
-forests, one torch thread).
+and the wall and CPU time of training (evaluations excluded; one core per agent:
+single-job forests, one torch thread).
 
 FQI's settings, the same on every env: the discount factor of the tuned DQN, 1,000 new
 transitions per iteration (2,000 on MountainCar, whose budget is longer) from 8 envs,
@@ -29,9 +29,11 @@ MushroomRL 1.10.2 pins an old torch and numpy, so install it without them:
     python benchmarks/bench_control.py --envs CartPole-v1 --seeds 0 --steps 3000 --eval-every 1000
 
 Writes ``bench_control.json`` and ``bench_control.png`` (return against env steps) under
-``--out``.
+``--out``, and each finished run under ``--out/runs/``: a rerun with the same arguments reuses
+those, so an interrupted full run resumes where it stopped.
 """
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -95,12 +97,22 @@ def make_regressor(name):
 
 class Checkpoints:
     """Evaluates a policy on the held-out seeds each time training passes a multiple of
-    `every` environment steps, and times it."""
+    `every` environment steps, and times training without its evaluations, in wall and CPU
+    seconds (CPU time does not count what other jobs on the machine take)."""
 
     def __init__(self, env_id, every, bar):
         self.env = gym.make_vec(env_id, len(EVAL_SEEDS), vectorization_mode="sync")
         self.every, self.bar = every, bar
-        self.curve, self.seconds, self._next, self._steps = [], 0.0, every, 0
+        self.curve, self._next, self._steps = [], every, 0
+        self.seconds = self.cpu_seconds = 0.0  # of the evaluations
+        self.train_seconds = self.train_cpu_seconds = None
+
+    @contextlib.contextmanager
+    def timed(self):
+        start, cpu_start = time.perf_counter(), time.process_time()
+        yield
+        self.train_seconds = time.perf_counter() - start - self.seconds
+        self.train_cpu_seconds = time.process_time() - cpu_start - self.cpu_seconds
 
     def __call__(self, policy, steps, last=False):
         self.bar.update(steps - self._steps)
@@ -108,9 +120,10 @@ class Checkpoints:
         due = steps >= self._next or (last and (not self.curve or self.curve[-1][0] != steps))
         if not due:
             return
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         mean = evaluate(policy, self.env, seeds=EVAL_SEEDS).mean
         self.seconds += time.perf_counter() - start
+        self.cpu_seconds += time.process_time() - cpu_start
         self.curve.append([int(steps), mean])
         self._next = (steps // self.every + 1) * self.every
         self.bar.set_postfix(steps=f"{steps:,}", mean_return=f"{mean:.1f}")
@@ -135,10 +148,10 @@ def run_fqi(env_id, agent_name, seed, steps, checkpoints):
         agent.epsilon = epsilon(agent.num_timesteps)  # the next collection's
         checkpoints(agent, agent.num_timesteps)
 
-    start = time.perf_counter()
-    agent.learn(math.ceil(steps / samples), callback=after_iteration)
-    checkpoints(agent, agent.num_timesteps, last=True)
-    return time.perf_counter() - start, agent.num_timesteps
+    with checkpoints.timed():
+        agent.learn(math.ceil(steps / samples), callback=after_iteration)
+        checkpoints(agent, agent.num_timesteps, last=True)
+    return agent.num_timesteps
 
 
 def run_dqn(env_id, seed, steps, checkpoints):
@@ -156,24 +169,25 @@ def run_dqn(env_id, seed, steps, checkpoints):
     model = DQN("MlpPolicy", gym.make(env_id), seed=seed, device="cpu",
                 **DQN_HYPERPARAMS[env_id])
     model.set_logger(Logger(None, []))  # SB3's default logger makes a folder per run
-    start = time.perf_counter()
-    model.learn(total_timesteps=steps, callback=Evaluations())
-    checkpoints(model, model.num_timesteps, last=True)
-    return time.perf_counter() - start, model.num_timesteps
+    with checkpoints.timed():
+        model.learn(total_timesteps=steps, callback=Evaluations())
+        checkpoints(model, model.num_timesteps, last=True)
+    return model.num_timesteps
 
 
 def run(env_id, agent_name, seed, steps, every):
     with tqdm(total=steps, desc=f"{env_id} {agent_name} seed {seed}", leave=False) as bar:
         checkpoints = Checkpoints(env_id, min(every, steps), bar)
         if agent_name == "dqn":
-            seconds, env_steps = run_dqn(env_id, seed, steps, checkpoints)
+            env_steps = run_dqn(env_id, seed, steps, checkpoints)
         else:
-            seconds, env_steps = run_fqi(env_id, agent_name, seed, steps, checkpoints)
+            env_steps = run_fqi(env_id, agent_name, seed, steps, checkpoints)
     threshold = ENVS[env_id]["threshold"]
     solved = next((s for s, mean in checkpoints.curve if mean >= threshold), None)
     return {"env": env_id, "agent": agent_name, "seed": seed, "env_steps": env_steps,
             "curve": checkpoints.curve, "final_mean": checkpoints.curve[-1][1],
-            "steps_to_threshold": solved, "train_seconds": seconds - checkpoints.seconds,
+            "steps_to_threshold": solved, "train_seconds": checkpoints.train_seconds,
+            "train_cpu_seconds": checkpoints.train_cpu_seconds,
             "eval_seconds": checkpoints.seconds}
 
 
@@ -262,19 +276,20 @@ def summarise(runs):
             "solved_runs": len(solved),
             "median_steps_to_threshold": float(np.median(solved)) if solved else None,
             "train_seconds": float(np.mean([r["train_seconds"] for r in group])),
+            "train_cpu_seconds": float(np.mean([r["train_cpu_seconds"] for r in group])),
         })
     return summary
 
 
 def markdown(summary, peers):
     lines = ["| env | agent | mean return (held-out seeds) | steps to threshold | solved runs "
-             "| train seconds |", "| --- | --- | --- | --- | --- | --- |"]
+             "| train seconds (CPU) |", "| --- | --- | --- | --- | --- | --- |"]
     for s in summary:
         steps = ("-" if s["median_steps_to_threshold"] is None
                  else f"{s['median_steps_to_threshold']:,.0f}")
         lines.append(f"| {s['env']} | {s['agent']} | {s['final_mean']:.1f} +- "
                      f"{s['final_sd']:.1f} | {steps} | {s['solved_runs']}/{len(s['seeds'])} | "
-                     f"{s['train_seconds']:.0f} |")
+                     f"{s['train_seconds']:.0f} ({s['train_cpu_seconds']:.0f}) |")
     if peers:
         lines += ["", "| CartPole-v1, offline FQI | mean return | seconds per iteration |",
                   "| --- | --- | --- |"]
@@ -332,7 +347,13 @@ def main(argv=None):
     runs = []
     for env_id, agent_name, seed in tqdm(plan, desc="bench_control"):
         steps = args.steps or ENVS[env_id]["steps"]
-        runs.append(run(env_id, agent_name, seed, steps, args.eval_every))
+        cached = out / "runs" / f"{env_id}_{agent_name}_seed{seed}_{steps}_{args.eval_every}.json"
+        if cached.exists():
+            runs.append(json.loads(cached.read_text()))
+        else:
+            runs.append(run(env_id, agent_name, seed, steps, args.eval_every))
+            cached.parent.mkdir(exist_ok=True)
+            cached.write_text(json.dumps(runs[-1], indent=1))
         r = runs[-1]
         tqdm.write(f"{env_id:<15} {agent_name:<12} seed {seed}: mean return "
                    f"{r['final_mean']:8.1f}, threshold at "

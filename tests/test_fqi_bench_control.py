@@ -7,9 +7,10 @@ import pytest
 from benchmarks import bench_control
 
 
-def test_tiny_run_writes_json_and_png(tmp_path, capsys):
-    bench_control.main(["--envs", "CartPole-v1", "--seeds", "0", "--steps", "400",
-                        "--eval-every", "200", "--no-peer", "--out", str(tmp_path)])
+def test_tiny_run_writes_json_and_png_and_resumes(tmp_path, capsys, monkeypatch):
+    argv = ["--envs", "CartPole-v1", "--seeds", "0", "--steps", "400", "--eval-every", "200",
+            "--no-peer", "--out", str(tmp_path)]
+    bench_control.main(argv)
     report = json.loads((tmp_path / "bench_control.json").read_text())
     assert (tmp_path / "bench_control.png").stat().st_size > 0
     assert {r["agent"] for r in report["runs"]} == set(bench_control.AGENTS)
@@ -17,7 +18,12 @@ def test_tiny_run_writes_json_and_png(tmp_path, capsys):
         assert run["env_steps"] >= 400 and [s for s, _ in run["curve"]][0] >= 200
         assert run["curve"][-1][0] == run["env_steps"] and run["steps_to_threshold"] is None
         assert run["train_seconds"] > 0 and run["eval_seconds"] > 0
+        assert run["train_cpu_seconds"] > 0
     assert "| CartPole-v1 | fqi-box |" in report["markdown"] in capsys.readouterr().out
+    # a rerun with the same arguments reuses the finished runs instead of training again
+    monkeypatch.setattr(bench_control, "run", lambda *args: pytest.fail("retrained"))
+    bench_control.main(argv)
+    assert json.loads((tmp_path / "bench_control.json").read_text())["runs"] == report["runs"]
 
 
 def test_fqi_explores_on_the_tuned_dqn_schedule():
