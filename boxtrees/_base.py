@@ -273,8 +273,9 @@ class ClassificationTargets(ClassifierMixin):
 class _TrainingObjects:
     """The training objects indexed for the tree builder.
 
-    Objects are grouped into segments, one per (type position, y band), and sorted by x in
-    each; ``sample_of`` is the sample of each object. Sets the estimator's ``types_``,
+    Objects of sets are grouped into segments, one per (type position, y band), and sorted
+    by x in each; ``sample_of`` is the sample of each object. A feature matrix is passed as it
+    is, as ``columns`` (the builder reads it in place). Sets the estimator's ``types_``,
     ``n_types_`` and ``bounds_``.
     """
 
@@ -291,9 +292,11 @@ class _TrainingObjects:
         estimator.n_types_ = len(estimator.types_)
         estimator.bounds_ = self.bounds = _sampling_region(estimator, x, y)
         self.local_x = features and estimator.view_bounds is None
-        self.one_per_sample = features
+        self.columns = None
         if features:
-            self._index_columns(sets)
+            # read in place; strides that are not whole elements are copied away
+            self.columns = sets if not any(s % sets.itemsize for s in sets.strides) else \
+                np.ascontiguousarray(sets)
         else:
             self._index_objects(estimator, sets, position)
 
@@ -310,18 +313,6 @@ class _TrainingObjects:
         self.segment_ptr = np.searchsorted(
             segments[order], np.arange(estimator.n_types_ * n_bands + 1)
         ).astype(np.intp)
-
-    def _index_columns(self, X):
-        """A feature matrix: one segment per column, its values sorted (no per-object type,
-        band or sort key arrays)."""
-        n_samples, n_features = X.shape
-        order = np.argsort(X, axis=0, kind="stable")
-        self.x = np.take_along_axis(X, order, axis=0).T.ravel()
-        self.sample_of = order.T.astype(np.int32).ravel()
-        del order
-        self.y = np.zeros(len(self.x), dtype=np.float32)
-        self.band_edges = np.array([-np.inf, np.inf])
-        self.segment_ptr = np.arange(n_features + 1, dtype=np.intp) * n_samples
 
 
 def _sampling_region(estimator, x, y):

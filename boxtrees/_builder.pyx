@@ -1,6 +1,6 @@
 """Growing one box-test tree (the hot loop of ``BoxExtraTreesRegressor.fit``).
 
-The training objects are kept in contiguous *segments*, one per (type, y band): the y axis is
+The training objects of sets are kept in contiguous *segments*, one per (type, y band): the y axis is
 cut into a few bands and the objects of a segment are sorted by x. Each node owns one
 contiguous range of every segment. A box test visits the bands its y extent overlaps and
 binary-searches the x strip of its box in each, so its cost is the number of objects in that
@@ -12,7 +12,8 @@ objects sorted by x. Samples are numbered by their position in the node order, n
 input row, and renumbered at every split, so a node's per-sample arrays (counts, weights,
 targets) are one contiguous range that stays in the fastest cache as nodes shrink. Nodes are
 grown depth first from an explicit stack: fixed 2 x 2 boxes make trees hundreds of levels
-deep.
+deep. A feature matrix is not copied: its splitter reads it in place through each sample's
+row, and scores a node's tests column by column.
 """
 import numpy as np
 
@@ -21,6 +22,8 @@ cimport numpy as cnp
 
 from libc.math cimport INFINITY
 from libc.limits cimport INT_MAX, UINT_MAX
+from libcpp.algorithm cimport sort
+from libcpp.utility cimport pair
 from libcpp.vector cimport vector
 
 from ._rows import scan_offsets
@@ -119,6 +122,8 @@ cdef extern from "_simd.h":
 cdef enum:
     SHORT_SEGMENT = 160  # segments up to this long are scanned whole instead of searched
     SIMD_SLACK = 16  # spare slots the SIMD compactions may write past their count
+    TEST_CHUNK = 256  # tests on a feature matrix drawn, then scored column by column,
+    TEST_BLOCK = 4    # this many in one pass over the column's values
 
 # the data-parallel kernels used by every tree (see _simd.h)
 cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)
@@ -133,49 +138,38 @@ def _set_simd(bint enabled):
     _kernels = boxtrees_select_kernels(enabled)
 
 
-@cython.final
 cdef class _Splitter:
     """Draws, scores and applies the box tests of the node being split.
 
-    Holds the tree's own copy of the segment buffers (it partitions them) and the per-sample
-    scratch arrays. Segment ``g = type * n_bands + band`` of the current node is
-    ``lo[g]:hi[g]``.
+    This base holds what every kind of training data shares: the per-sample arrays, which
+    split() reorders so that a node's samples are one contiguous range of ids; the draw of a
+    test; its score from a child's sums; and the search for the best of ``n_tests``. The
+    subclasses say where the objects are: `_ObjectSplitter` (object sets, kept in sorted
+    segments) and `_ColumnSplitter` (a feature matrix, read where it is).
     """
     cdef list _keep_alive            # the NumPy arrays behind the pointers below (see _own)
-    cdef coord_t* xs
-    cdef coord_t* ys
-    cdef int32* sid
-    cdef coord_t* tmp_x
-    cdef coord_t* tmp_y
-    cdef int32* tmp_sid
-    cdef int32* strip                # sample ids of the objects of a strip inside the box
     cdef int32* order                # scratch of split(): the old id of each new position
     cdef int32* new_id               # scratch of split(): the new id of each old one
     cdef float64_t* tmp_value        # scratch of split(): one per-sample array reordered
     cdef float64_t* sums             # scratch of the scoring: per output, right then left sums
-    cdef int32* counts
-    cdef int32* hits
-    cdef uint8* goes_right
-    cdef intp_t* lo
-    cdef intp_t* hi
+    cdef uint8* goes_right           # set by _mark_right for split()
     # per sample, indexed by its current id (its position in the node order)
     cdef float64_t* target           # n_outputs per sample
     cdef float64_t* weight
     cdef float64_t* weighted_target  # weight * target
     cdef intp_t n_outputs
+    # segment g of the current node is lo[g]:hi[g] (object sets; a feature matrix has none)
+    cdef intp_t* lo
+    cdef intp_t* hi
     cdef double* region              # per type of the current node: x0, x1, y0, y1 of its tests
     cdef intp_t* type_size           # per type: the current node's number of objects
     cdef intp_t* live                # the types tests are drawn on in the current node
     cdef intp_t n_live
-    cdef const float64_t* edges      # band edges, n_bands + 1, from -inf to +inf
     cdef const coord_t[:, ::1] bounds
     cdef intp_t n_samples
     cdef intp_t n_types
-    cdef intp_t n_bands
     cdef int kind
     cdef double width
-    cdef bint local_x
-    cdef bint one_per_sample         # every sample has exactly one object of each type
     cdef intp_t n_tests
     cdef intp_t max_retries
     cdef uint64 rng
@@ -186,32 +180,14 @@ cdef class _Splitter:
     cdef float64_t* wy_sum           # per output
     cdef double tie                  # proxies closer than this are ties (rounding noise)
 
-    def __cinit__(self, objects, intp_t max_segment, target, weight, params, uint64 seed):
+    def __cinit__(self, objects, const intp_t[::1] segment_ptr, target, weight, params,
+                  uint64 seed):
         cdef const coord_t[:, ::1] bounds = objects.bounds
-        cdef intp_t n_samples = len(target)
-        cdef intp_t n_segments = bounds.shape[0] * (len(objects.band_edges) - 1)
+        cdef intp_t n_samples = len(target), n_segments = segment_ptr.shape[0] - 1
         self._keep_alive = []
-        self.xs = <coord_t*>self._own(np.array(objects.x, dtype=np.float32))
-        self.ys = <coord_t*>self._own(np.array(objects.y, dtype=np.float32))
-        # checked here, on the copy the tree uses
-        sid = np.array(objects.sample_of, dtype=np.int32)
-        if sid.size and (sid.min() < 0 or sid.max() >= n_samples):
-            raise ValueError(f"sample_of must hold sample ids in [0, {n_samples})")
-        self.sid = <int32*>self._own(sid)
-        # scratch for one segment at a time: its right-going objects, or a strip's hits
-        self.tmp_x = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
-        self.tmp_y = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
-        self.tmp_sid = <int32*>self._own(np.empty(max_segment, dtype=np.int32))
-        self.strip = <int32*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.int32))
         self.order = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
         self.new_id = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
-        self.counts = <int32*>self._own(np.zeros(n_samples, dtype=np.int32))
-        # one spare slot: the branch-free scatter in count() stores a sample id before it
-        # knows whether the sample is new, so with every sample hit it writes one past them
-        self.hits = <int32*>self._own(np.empty(n_samples + 1, dtype=np.int32))
         self.goes_right = <uint8*>self._own(np.zeros(n_samples, dtype=np.uint8))
-        self.lo = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
-        self.hi = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
         # own copies: split() reorders them
         target = np.array(target, dtype=np.float64).reshape(n_samples, -1)
         weight = np.array(weight, dtype=np.float64)
@@ -222,32 +198,31 @@ cdef class _Splitter:
         self.tmp_value = <float64_t*>self._own(np.empty(n_samples * self.n_outputs, dtype=np.float64))
         self.sums = <float64_t*>self._own(np.empty(2 * self.n_outputs, dtype=np.float64))
         self.wy_sum = <float64_t*>self._own(np.empty(self.n_outputs, dtype=np.float64))
-        self.edges = <const float64_t*>self._own(np.array(objects.band_edges, dtype=np.float64))
-        self.region = <double*>self._own(np.empty(4 * bounds.shape[0], dtype=np.float64))
+        self.lo = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
+        self.hi = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
+        self.region = <double*>self._own(np.array(bounds, dtype=np.float64))
         self.type_size = <intp_t*>self._own(np.empty(bounds.shape[0], dtype=np.intp))
         self.live = <intp_t*>self._own(np.arange(bounds.shape[0], dtype=np.intp))
         self.n_live = bounds.shape[0]
         self.bounds = bounds
         self.n_samples = n_samples
         self.n_types = bounds.shape[0]
-        self.n_bands = len(objects.band_edges) - 1
-        self.local_x = objects.local_x
-        self.one_per_sample = objects.one_per_sample and self.n_bands == 1
         self.kind = TEST_KINDS[params.test_type]
         self.width = params.test_width
         self.n_tests = params.n_tests
         self.max_retries = params.max_retries
         self.rng = seed
 
+    cdef void* _own(self, cnp.ndarray array):
+        """Keep ``array`` alive as long as the splitter and return its data pointer."""
+        self._keep_alive.append(array)
+        return cnp.PyArray_DATA(array)
+
+    @cython.final
     cdef void start_node(self, intp_t start, intp_t end, double w_sum, const float64_t* wy_sum,
                          double wy2_sum) noexcept nogil:
-        """Make samples ``start:end`` (and the segment ranges ``lo:hi``) the node to split.
-
-        Tests are drawn on every type of the training set, or with node-local ranges (feature
-        matrices) on the columns that are not constant in the node.
-        """
-        cdef intp_t ty, g, k
-        cdef double* r
+        """Make samples ``start:end`` (and the segment ranges ``lo:hi``) the node to split."""
+        cdef intp_t k
         self.start = start
         self.end = end
         self.w_sum = w_sum
@@ -257,33 +232,13 @@ cdef class _Splitter:
         # and the test drawn first wins them, so equal data in another order or as repeated
         # rows instead of integer weights gives the same tree.
         self.tie = TIE_TOLERANCE * wy2_sum
-        for ty in range(self.n_types):
-            r = self.region + 4 * ty
-            r[0] = self.bounds[ty, 0]
-            r[1] = self.bounds[ty, 1]
-            r[2] = self.bounds[ty, 2]
-            r[3] = self.bounds[ty, 3]
-            self.type_size[ty] = 0
-            if self.local_x:
-                r[0], r[1] = INFINITY, -INFINITY
-            for g in range(ty * self.n_bands, (ty + 1) * self.n_bands):
-                self.type_size[ty] += self.hi[g] - self.lo[g]
-                if self.local_x and self.hi[g] > self.lo[g]:
-                    r[0] = min(r[0], self.xs[self.lo[g]])
-                    r[1] = max(r[1], self.xs[self.hi[g] - 1])
-        if self.local_x:
-            self.n_live = 0
-            for ty in range(self.n_types):
-                r = self.region + 4 * ty
-                if r[1] - r[0] > FEATURE_THRESHOLD:
-                    self.live[self.n_live] = ty
-                    self.n_live += 1
+        self._find_regions()
 
-    cdef void* _own(self, cnp.ndarray array):
-        """Keep ``array`` alive as long as the splitter and return its data pointer."""
-        self._keep_alive.append(array)
-        return cnp.PyArray_DATA(array)
+    cdef void _find_regions(self) noexcept nogil:
+        """Set ``type_size`` (and, where tests follow the node, ``region`` and ``live``) for
+        the current node."""
 
+    @cython.final
     cdef bint sample_test(self, BoxTest* t) noexcept nogil:
         """Draw a test; False when its type has no object in the node (it cannot split)."""
         cdef intp_t ty = self.live[rand_int(&self.rng, self.n_live)]
@@ -323,6 +278,133 @@ cdef class _Splitter:
                 a = rand_uniform(&self.rng, y0, y1)
                 t.ymin, t.ymax = a - h, a + h
         return True
+
+    @cython.final
+    cdef bint _score(self, BoxTest* t, double wl, double wr, bint right) noexcept nogil:
+        """Score a test from one child's sums of weight * target, in ``sums[:n_outputs]``:
+        the right child's if ``right``, else the left's. False when a child has no weight."""
+        cdef float64_t* known = self.sums
+        cdef float64_t* other = self.sums + self.n_outputs
+        cdef intp_t k
+        if wl <= 0.0 or wr <= 0.0:
+            return False
+        for k in range(self.n_outputs):
+            other[k] = self.wy_sum[k] - known[k]
+        if right:
+            t.proxy = split_proxy(wl, other, wr, known, self.n_outputs)
+        else:
+            t.proxy = split_proxy(wl, known, wr, other, self.n_outputs)
+        return True
+
+    cdef bint find_best(self, BoxTest* best) noexcept nogil:
+        """The best of ``n_tests`` random tests, in up to ``1 + max_retries`` rounds until one
+        splits; False if none does. Ties within ``tie`` go to the test drawn first."""
+        return False
+
+    @cython.final
+    cdef intp_t split(self, const BoxTest* best, intp_t* right_lo) noexcept nogil:
+        """Send the node's samples and objects left or right; return the first right sample.
+
+        The node's samples are renumbered: the left child's become ``start:mid`` and the right
+        child's ``mid:end``. Per segment, the left child's objects end up in
+        ``lo[g]:right_lo[g]`` and the right child's in ``right_lo[g]:hi[g]``, each still
+        sorted by x.
+        """
+        cdef int32* order = self.order
+        cdef intp_t i, k
+        self._mark_right(best)
+        for i in range(self.start, self.end):
+            order[i] = <int32>i
+        i = self.start
+        k = self.end
+        while i < k:
+            if self.goes_right[order[i]]:
+                k -= 1
+                order[i], order[k] = order[k], order[i]
+            else:
+                i += 1
+        for k in range(self.start, self.end):
+            self.new_id[order[k]] = <int32>k
+        self._reorder(self.target, self.n_outputs)
+        self._reorder(self.weight, 1)
+        self._reorder(self.weighted_target, self.n_outputs)
+        self._move_objects(<int32>i, right_lo)
+        return i
+
+    cdef void _mark_right(self, const BoxTest* best) noexcept nogil:
+        """Set ``goes_right`` of the node's samples (by current id) that the test sends right."""
+
+    cdef void _move_objects(self, int32 mid, intp_t* right_lo) noexcept nogil:
+        """Follow the renumbering of split() (``order``, ``new_id``) in the objects' arrays,
+        and leave ``goes_right`` all zero."""
+
+    @cython.final
+    cdef void _reorder(self, float64_t* values, intp_t width) noexcept nogil:
+        """Move the node's rows of a per-sample array (``width`` values per sample) to the
+        samples' new ids."""
+        cdef intp_t k, o
+        for k in range(self.start, self.end):
+            for o in range(width):
+                self.tmp_value[k * width + o] = values[self.order[k] * width + o]
+        for k in range(self.start * width, self.end * width):
+            values[k] = self.tmp_value[k]
+
+
+@cython.final
+cdef class _ObjectSplitter(_Splitter):
+    """The splitter of object sets: the tree's own copy of the segment buffers, which split()
+    partitions, and the per-sample counts of a test. Segment ``g = type * n_bands + band``
+    of the current node is ``lo[g]:hi[g]``."""
+    cdef coord_t* xs
+    cdef coord_t* ys
+    cdef int32* sid
+    cdef coord_t* tmp_x
+    cdef coord_t* tmp_y
+    cdef int32* tmp_sid
+    cdef int32* strip                # sample ids of the objects of a strip inside the box
+    cdef int32* counts
+    cdef int32* hits
+    cdef intp_t n_hit                # of the test being applied by split()
+    cdef const float64_t* edges      # band edges, n_bands + 1, from -inf to +inf
+    cdef intp_t n_bands
+
+    def __cinit__(self, objects, const intp_t[::1] segment_ptr, target, weight, params,
+                  uint64 seed):
+        cdef intp_t n_samples = self.n_samples
+        cdef intp_t max_segment = max(np.diff(segment_ptr).max(initial=0), 1)
+        # checked here, on the copies the tree uses
+        x = np.array(objects.x, dtype=np.float32)
+        y = np.array(objects.y, dtype=np.float32)
+        sid = np.array(objects.sample_of, dtype=np.int32)
+        if not x.shape == y.shape == sid.shape == (segment_ptr[segment_ptr.shape[0] - 1],):
+            raise ValueError("x, y and sample_of must have one entry per object")
+        if sid.size and (sid.min() < 0 or sid.max() >= n_samples):
+            raise ValueError(f"sample_of must hold sample ids in [0, {n_samples})")
+        self.xs = <coord_t*>self._own(x)
+        self.ys = <coord_t*>self._own(y)
+        self.sid = <int32*>self._own(sid)
+        # scratch for one segment at a time: its right-going objects, or a strip's hits
+        self.tmp_x = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
+        self.tmp_y = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
+        self.tmp_sid = <int32*>self._own(np.empty(max_segment, dtype=np.int32))
+        self.strip = <int32*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.int32))
+        self.counts = <int32*>self._own(np.zeros(n_samples, dtype=np.int32))
+        # one spare slot: the branch-free scatter in count() stores a sample id before it
+        # knows whether the sample is new, so with every sample hit it writes one past them
+        self.hits = <int32*>self._own(np.empty(n_samples + 1, dtype=np.int32))
+        edges = np.array(objects.band_edges, dtype=np.float64)
+        if edges.ndim != 1 or (edges.shape[0] - 1) * self.n_types != segment_ptr.shape[0] - 1:
+            raise ValueError("segment_ptr must have n_types * n_bands + 1 entries")
+        self.edges = <const float64_t*>self._own(edges)
+        self.n_bands = edges.shape[0] - 1
+
+    cdef void _find_regions(self) noexcept nogil:
+        """Tests are drawn on every type of the training set, in its region."""
+        cdef intp_t ty, g
+        for ty in range(self.n_types):
+            self.type_size[ty] = 0
+            for g in range(ty * self.n_bands, (ty + 1) * self.n_bands):
+                self.type_size[ty] += self.hi[g] - self.lo[g]
 
     cdef intp_t count(self, const BoxTest* t, int32* cmax) noexcept nogil:
         """Count, per node sample, its objects of the test's type strictly inside the box.
@@ -415,65 +497,7 @@ cdef class _Splitter:
                     right_sums[k] += right * self.weighted_target[s * n_outputs + k]
         return self._score(t, self.w_sum - wr, wr, True)
 
-    cdef inline bint _score(self, BoxTest* t, double wl, double wr, bint right) noexcept nogil:
-        """Score a test from one child's sums of weight * target, in ``sums[:n_outputs]``:
-        the right child's if ``right``, else the left's. False when a child has no weight."""
-        cdef float64_t* known = self.sums
-        cdef float64_t* other = self.sums + self.n_outputs
-        cdef intp_t k
-        if wl <= 0.0 or wr <= 0.0:
-            return False
-        for k in range(self.n_outputs):
-            other[k] = self.wy_sum[k] - known[k]
-        if right:
-            t.proxy = split_proxy(wl, other, wr, known, self.n_outputs)
-        else:
-            t.proxy = split_proxy(wl, known, wr, other, self.n_outputs)
-        return True
-
-    cdef bint evaluate_single(self, BoxTest* t) noexcept nogil:
-        """``evaluate`` when each sample has exactly one object of each type (a feature matrix).
-
-        Counts are then 0 or 1, the threshold is 1 and the right child is the samples of the
-        objects in the box's strip: its sums come straight from the strip or, if shorter, from
-        its complement, with no per-sample counting.
-        """
-        cdef intp_t lo = self.lo[t.object_type], hi = self.hi[t.object_type], a, e, k
-        cdef double w_in
-        cdef bint inside
-        _strip(self.xs, lo, hi, t.xmin, t.xmax, &a, &e)
-        if e == a or e - a == hi - lo:
-            return False
-        t.threshold = 1 + <int32>rand_int(&self.rng, 1)   # the draw keeps evaluate's sequence
-        inside = 2 * (e - a) <= hi - lo
-        for k in range(self.n_outputs):
-            self.sums[k] = 0.0
-        if inside:               # the strip is the right child
-            w_in = self._add_run(a, e, 0.0)
-            return self._score(t, self.w_sum - w_in, w_in, True)
-        w_in = self._add_run(e, hi, self._add_run(lo, a, 0.0))
-        return self._score(t, w_in, self.w_sum - w_in, False)
-
-    cdef inline double _add_run(self, intp_t a, intp_t e, double w) noexcept nogil:
-        """Add the weights of the samples of objects ``a:e`` to ``w`` (returned) and their
-        weight * target to ``sums[:n_outputs]``."""
-        cdef const int32* sid = self.sid
-        cdef intp_t k, o, n_outputs = self.n_outputs
-        cdef double wy = self.sums[0]
-        if n_outputs == 1:
-            for k in range(a, e):
-                w += self.weight[sid[k]]
-                wy += self.weighted_target[sid[k]]
-            self.sums[0] = wy
-            return w
-        for k in range(a, e):
-            w += self.weight[sid[k]]
-            for o in range(n_outputs):
-                self.sums[o] += self.weighted_target[sid[k] * n_outputs + o]
-        return w
-
     cdef bint find_best(self, BoxTest* best) noexcept nogil:
-        """Best of ``n_tests`` random tests, retried up to ``max_retries`` rounds if none splits."""
         cdef BoxTest t
         cdef intp_t r, k
         cdef bint found = False
@@ -482,9 +506,7 @@ cdef class _Splitter:
             return False
         for r in range(self.max_retries + 1):
             for k in range(self.n_tests):
-                if not self.sample_test(&t):
-                    continue
-                if not (self.evaluate_single(&t) if self.one_per_sample else self.evaluate(&t)):
+                if not self.sample_test(&t) or not self.evaluate(&t):
                     continue
                 if not found or t.proxy > best.proxy + self.tie:
                     best[0] = t
@@ -493,57 +515,213 @@ cdef class _Splitter:
                 break
         return found
 
-    cdef intp_t split(self, const BoxTest* best, intp_t* right_lo) noexcept nogil:
-        """Send the node's samples and objects left or right; return the first right sample.
-
-        The node's samples are renumbered: the left child's become ``start:mid`` and the right
-        child's ``mid:end``. Per segment, the left child's objects end up in
-        ``lo[g]:right_lo[g]`` and the right child's in ``right_lo[g]:hi[g]``, each still
-        sorted by x.
-        """
-        cdef int32 cmax
-        cdef intp_t n_hit = self.count(best, &cmax)
-        cdef int32* order = self.order
-        cdef uint8* goes_right = self.goes_right
-        cdef intp_t i, j, k, g
-        cdef int32 s
-        for j in range(n_hit):
+    cdef void _mark_right(self, const BoxTest* best) noexcept nogil:
+        cdef int32 cmax, s
+        cdef intp_t j
+        self.n_hit = self.count(best, &cmax)
+        for j in range(self.n_hit):
             s = self.hits[j]
-            goes_right[s] = self.counts[s] >= best.threshold
+            self.goes_right[s] = self.counts[s] >= best.threshold
             self.counts[s] = 0
-        for i in range(self.start, self.end):
-            order[i] = <int32>i
-        i = self.start
-        k = self.end
-        while i < k:
-            if goes_right[order[i]]:
-                k -= 1
-                order[i], order[k] = order[k], order[i]
-            else:
-                i += 1
-        for k in range(self.start, self.end):
-            self.new_id[order[k]] = <int32>k
-        self._reorder(self.target, self.n_outputs)
-        self._reorder(self.weight, 1)
-        self._reorder(self.weighted_target, self.n_outputs)
+
+    cdef void _move_objects(self, int32 mid, intp_t* right_lo) noexcept nogil:
+        cdef intp_t g, j
         for g in range(self.n_types * self.n_bands):
             right_lo[g] = self.lo[g] + _kernels.partition(
                 self.xs + self.lo[g], self.ys + self.lo[g], self.sid + self.lo[g],
-                self.hi[g] - self.lo[g], self.new_id, <int32>i, self.tmp_x, self.tmp_y,
+                self.hi[g] - self.lo[g], self.new_id, mid, self.tmp_x, self.tmp_y,
                 self.tmp_sid)
-        for j in range(n_hit):
-            goes_right[self.hits[j]] = 0
-        return i
+        for j in range(self.n_hit):
+            self.goes_right[self.hits[j]] = 0
 
-    cdef void _reorder(self, float64_t* values, intp_t width) noexcept nogil:
-        """Move the node's rows of a per-sample array (``width`` values per sample) to the
-        samples' new ids."""
-        cdef intp_t k, o
+
+@cython.final
+cdef class _ColumnSplitter(_Splitter):
+    """The splitter of a feature matrix: column ``j`` is a one-dimensional object of type
+    ``j``, one per sample. The matrix is read where it is, through the row of each sample
+    (as scikit-learn's trees do), so a tree needs memory for its samples, not a copy of the
+    matrix."""
+    cdef const coord_t[:, :] columns
+    cdef intp_t row_stride           # in elements
+    cdef intp_t column_stride
+    cdef int32* rows                 # per sample (by current id): its row of the matrix
+    cdef int32* tmp_rows
+    cdef coord_t* values             # per sample: the gathered values of one column
+    cdef coord_t* node_min           # per column: its range in the current node
+    cdef coord_t* node_max
+    cdef bint local_x
+    cdef bint unit_weights           # every weight is 1
+
+    def __cinit__(self, objects, const intp_t[::1] segment_ptr, target, weight, params,
+                  uint64 seed):
+        self.columns = objects.columns
+        if self.columns.shape[0] != self.n_samples or self.columns.shape[1] != self.n_types:
+            raise ValueError(f"columns must have shape ({self.n_samples}, {self.n_types}), "
+                             f"one row per sample and one column per type of bounds")
+        self.row_stride = self.columns.strides[0] // sizeof(coord_t)
+        self.column_stride = self.columns.strides[1] // sizeof(coord_t)
+        self.rows = <int32*>self._own(np.arange(self.n_samples, dtype=np.int32))
+        self.tmp_rows = <int32*>self._own(np.empty(self.n_samples, dtype=np.int32))
+        self.values = <coord_t*>self._own(np.empty(self.n_samples, dtype=np.float32))
+        self.node_min = <coord_t*>self._own(np.empty(self.n_types, dtype=np.float32))
+        self.node_max = <coord_t*>self._own(np.empty(self.n_types, dtype=np.float32))
+        self.local_x = objects.local_x
+        self.unit_weights = bool((np.asarray(weight) == 1.0).all())
+
+    cdef void _find_regions(self) noexcept nogil:
+        """Every column has one object per sample. With ``local_x`` tests are drawn within
+        each column's range in the node, on the columns that are not constant there."""
+        cdef const coord_t* row
+        cdef coord_t* lo = self.node_min
+        cdef coord_t* hi = self.node_max
+        cdef intp_t i, ty, cs = self.column_stride
+        cdef double* r
+        for ty in range(self.n_types):
+            self.type_size[ty] = self.end - self.start
+        if not self.local_x:
+            return
+        for ty in range(self.n_types):
+            lo[ty], hi[ty] = INFINITY, -INFINITY
+        for i in range(self.start, self.end):
+            row = &self.columns[0, 0] + self.rows[i] * self.row_stride
+            for ty in range(self.n_types):
+                lo[ty] = min(lo[ty], row[ty * cs])
+                hi[ty] = max(hi[ty], row[ty * cs])
+        self.n_live = 0
+        for ty in range(self.n_types):
+            r = self.region + 4 * ty
+            r[0], r[1] = lo[ty], hi[ty]
+            if r[1] - r[0] > FEATURE_THRESHOLD:
+                self.live[self.n_live] = ty
+                self.n_live += 1
+
+    cdef bint find_best(self, BoxTest* best) noexcept nogil:
+        """Tests are drawn a chunk at a time and scored column by column: the node's values
+        of a column are gathered once (one strided read per sample) for all the chunk's tests
+        on it, which then read them contiguously."""
+        cdef BoxTest tests[TEST_CHUNK]
+        cdef bint valid[TEST_CHUNK]
+        cdef vector[pair[intp_t, intp_t]] by_column      # (column, test) of the chunk
+        cdef BoxTest* block[TEST_BLOCK]
+        cdef intp_t r, first, m, k, j, n, column
+        cdef bint found = False
+        best.proxy = -INFINITY
+        if self.n_live == 0:
+            return False
+        by_column.resize(TEST_CHUNK)
+        for r in range(self.max_retries + 1):
+            first = 0
+            while first < self.n_tests:
+                m = min(<intp_t>TEST_CHUNK, self.n_tests - first)
+                first += m
+                for k in range(m):
+                    self.sample_test(&tests[k])     # a column has an object in every sample
+                    by_column[k] = pair[intp_t, intp_t](tests[k].object_type, k)
+                sort(by_column.begin(), by_column.begin() + m)
+                j = 0
+                while j < m:              # the chunk's tests on one column, TEST_BLOCK at once
+                    column = by_column[j].first
+                    self._gather(column)
+                    while j < m and by_column[j].first == column:
+                        n = 1
+                        while n < TEST_BLOCK and j + n < m and by_column[j + n].first == column:
+                            n += 1
+                        for k in range(n):
+                            block[k] = &tests[by_column[j + k].second]
+                        self._score_gathered(block, n)
+                        for k in range(n):
+                            valid[by_column[j + k].second] = block[k].threshold == 1
+                        j += n
+                for k in range(m):
+                    if valid[k] and (not found or tests[k].proxy > best.proxy + self.tie):
+                        best[0] = tests[k]
+                        found = True
+            if found:
+                break
+        return found
+
+    cdef void _gather(self, intp_t column) noexcept nogil:
+        """Copy the node's values of ``column`` to ``values[start:end]``."""
+        cdef const coord_t* values = &self.columns[0, 0] + column * self.column_stride
+        cdef intp_t i, rs = self.row_stride
+        for i in range(self.start, self.end):
+            self.values[i] = values[self.rows[i] * rs]
+
+    cdef void _score_gathered(self, BoxTest** tests, intp_t n) noexcept nogil:
+        """Score ``n <= TEST_BLOCK`` tests on the gathered values of their column, in one pass that
+        keeps each test's sums apart (and in the same order as alone). Counts are 0 or 1, so
+        the threshold is 1 and the right child is the samples whose value lies in the box's
+        x extent; a test that sends none or all of them right cannot split: its threshold is
+        set to 0."""
+        cdef const coord_t* values = self.values
+        cdef coord_t lo[TEST_BLOCK]
+        cdef coord_t hi[TEST_BLOCK]
+        cdef intp_t n_in[TEST_BLOCK]
+        cdef double w_in[TEST_BLOCK]
+        cdef double wy[TEST_BLOCK]
+        cdef double inside
+        cdef coord_t v
+        cdef intp_t i, k, o, n_outputs = self.n_outputs
+        for k in range(TEST_BLOCK):
+            lo[k], hi[k] = INFINITY, -INFINITY    # unused slots: an empty box
+            if k < n:
+                lo[k], hi[k] = tests[k].xmin, tests[k].xmax
+            n_in[k], w_in[k], wy[k] = 0, 0.0, 0.0
+        if n_outputs == 1 and self.unit_weights:   # the sum of the weights is the count
+            for i in range(self.start, self.end):
+                v = values[i]
+                for k in range(TEST_BLOCK):
+                    inside = (lo[k] < v) & (v < hi[k])
+                    n_in[k] += <intp_t>inside
+                    wy[k] += inside * self.weighted_target[i]
+            for k in range(TEST_BLOCK):
+                w_in[k] = <double>n_in[k]
+        elif n_outputs == 1:
+            for i in range(self.start, self.end):
+                v = values[i]
+                for k in range(TEST_BLOCK):
+                    inside = (lo[k] < v) & (v < hi[k])
+                    n_in[k] += <intp_t>inside
+                    w_in[k] += inside * self.weight[i]
+                    wy[k] += inside * self.weighted_target[i]
+        else:
+            for i in range(self.start, self.end):
+                v = values[i]
+                for k in range(TEST_BLOCK):
+                    inside = (lo[k] < v) & (v < hi[k])
+                    n_in[k] += <intp_t>inside
+                    w_in[k] += inside * self.weight[i]
+        for k in range(n):
+            tests[k].threshold = 0
+            if n_in[k] == 0 or n_in[k] == self.end - self.start:
+                continue
+            if n_outputs == 1:
+                self.sums[0] = wy[k]
+            else:
+                for o in range(n_outputs):
+                    self.sums[o] = 0.0
+                for i in range(self.start, self.end):
+                    inside = (lo[k] < values[i]) & (values[i] < hi[k])
+                    for o in range(n_outputs):
+                        self.sums[o] += inside * self.weighted_target[i * n_outputs + o]
+            if self._score(tests[k], self.w_sum - w_in[k], w_in[k], True):
+                tests[k].threshold = 1
+
+    cdef void _mark_right(self, const BoxTest* best) noexcept nogil:
+        cdef const coord_t* column = &self.columns[0, 0] + best.object_type * self.column_stride
+        cdef intp_t i
+        cdef coord_t v
+        for i in range(self.start, self.end):
+            v = column[self.rows[i] * self.row_stride]
+            self.goes_right[i] = (best.xmin < v) & (v < best.xmax)
+
+    cdef void _move_objects(self, int32 mid, intp_t* right_lo) noexcept nogil:
+        cdef intp_t k
         for k in range(self.start, self.end):
-            for o in range(width):
-                self.tmp_value[k * width + o] = values[self.order[k] * width + o]
-        for k in range(self.start * width, self.end * width):
-            values[k] = self.tmp_value[k]
+            self.tmp_rows[k] = self.rows[self.order[k]]
+            self.goes_right[k] = 0
+        for k in range(self.start, self.end):
+            self.rows[k] = self.tmp_rows[k]
 
 
 cdef void _grow(_Splitter splitter, vector[Node]* nodes, vector[float64_t]* values,
@@ -625,21 +803,20 @@ def build_tree(objects, target, weight, params, uint64 seed):
     Parameters
     ----------
     objects : object
-        The training objects indexed for the builder (``boxtrees._base._TrainingObjects``),
-        with attributes
+        The training data indexed for the builder (``boxtrees._base._TrainingObjects``):
+        ``bounds``, shape (n_types, 4), the region ``(xmin, xmax, ymin, ymax)`` in which tests
+        of each type are drawn (``ymin = -inf`` marks one-dimensional objects), and either
 
-        - ``x, y, sample_of``, arrays of shape (n_objects,): the objects grouped by segment
-          (type position, then y band), sorted by x within each segment, and the sample each
-          belongs to;
-        - ``segment_ptr``, shape (n_types * n_bands + 1,): segment ``g = type * n_bands +
-          band`` is ``segment_ptr[g]:segment_ptr[g + 1]``;
-        - ``band_edges``, shape (n_bands + 1,): band ``b`` holds the objects with
-          ``band_edges[b] <= y < band_edges[b + 1]``, from -inf to +inf;
-        - ``bounds``, shape (n_types, 4): region ``(xmin, xmax, ymin, ymax)`` in which tests
-          of each type are drawn; ``ymin = -inf`` marks one-dimensional objects;
-        - ``local_x``: draw the x extent of a test within the node's range of its type;
-        - ``one_per_sample``: every sample has one object of each type (a feature matrix),
-          which enables a faster, equivalent scoring of tests.
+        - ``columns``, a float32 feature matrix of shape (n_samples, n_types), whose column
+          ``j`` is the one object of type ``j`` of each sample, and ``local_x``: draw the x
+          extent of a test within its column's range in the node; or
+        - ``columns = None`` (or absent) and object sets: ``x, y, sample_of``, arrays of
+          shape (n_objects,), the objects grouped by segment (type position, then y band),
+          sorted by x within each segment, and the sample each belongs to;
+          ``segment_ptr``, shape (n_types * n_bands + 1,): segment ``g = type * n_bands +
+          band`` is ``segment_ptr[g]:segment_ptr[g + 1]``; ``band_edges``, shape
+          (n_bands + 1,): band ``b`` holds the objects with ``band_edges[b] <= y <
+          band_edges[b + 1]``, from -inf to +inf.
     target : array of shape (n_samples,) or (n_samples, n_outputs)
         Targets (encoded class indicators for a classifier); ``n_samples < 2**31``.
     weight : array of shape (n_samples,)
@@ -657,23 +834,27 @@ def build_tree(objects, target, weight, params, uint64 seed):
         When the arrays do not fit together (the tree reads them by index, so they are
         checked, on the copies it uses, before it grows).
     """
-    segment_ptr = np.array(objects.segment_ptr, dtype=np.intp)
     cdef const coord_t[:, ::1] bounds = objects.bounds
-    n_objects, n_samples = len(objects.x), len(target)
-    n_bands = len(objects.band_edges) - 1
-    if len(objects.y) != n_objects or len(objects.sample_of) != n_objects:
-        raise ValueError("x, y and sample_of must have one entry per object")
+    n_samples = len(target)
     if len(weight) != n_samples or not 0 < n_samples < INT_MAX:
         raise ValueError(f"target and weight must have the same length, from 1 to {INT_MAX - 1}")
-    if bounds.shape[1] != 4 or n_bands < 1 or segment_ptr.shape != (bounds.shape[0] * n_bands + 1,):
-        raise ValueError("bounds must be (n_types, 4) and segment_ptr must have "
-                         "n_types * n_bands + 1 entries")
-    if scan_offsets(segment_ptr, n_objects) != -1:
-        raise ValueError(f"segment_ptr must rise from 0 to the number of objects, {n_objects}")
+    if bounds.shape[1] != 4:
+        raise ValueError("bounds must be (n_types, 4)")
     if not 0 < params.n_tests <= UINT_MAX or params.max_retries < 0:
         raise ValueError(f"n_tests must be in [1, {UINT_MAX}] and max_retries >= 0")
-    cdef intp_t max_segment = max(np.diff(segment_ptr).max(initial=0), 1)
-    cdef _Splitter splitter = _Splitter(objects, max_segment, target, weight, params, seed)
+    cdef _Splitter splitter
+    if getattr(objects, "columns", None) is not None:
+        segment_ptr = np.zeros(1, dtype=np.intp)        # no segments
+        splitter = _ColumnSplitter(objects, segment_ptr, target, weight, params, seed)
+    else:
+        segment_ptr = np.array(objects.segment_ptr, dtype=np.intp)
+        n_objects, n_bands = len(objects.x), len(objects.band_edges) - 1
+        if n_bands < 1 or segment_ptr.shape != (bounds.shape[0] * n_bands + 1,):
+            raise ValueError("bounds must be (n_types, 4) and segment_ptr must have "
+                             "n_types * n_bands + 1 entries")
+        if scan_offsets(segment_ptr, n_objects) != -1:
+            raise ValueError(f"segment_ptr must rise from 0 to the number of objects, {n_objects}")
+        splitter = _ObjectSplitter(objects, segment_ptr, target, weight, params, seed)
     cdef vector[Node] nodes
     cdef vector[float64_t] values
     cdef const intp_t[::1] segments = segment_ptr

@@ -24,12 +24,8 @@ _tree = importlib.import_module("boxtrees._tree")
 _NODE_ARRAYS = _builder.NODE_FIELDS
 
 
-def grow(x, y, sample, segment_ptr, edges, target, weight, bounds, test_type, width=0.7,
-         n_tests=20, seed=0, features=False):
+def grow(objects, target, weight, test_type, width=0.7, n_tests=20, seed=0):
     """One tree from the builder, with small parameters."""
-    objects = SimpleNamespace(x=x, y=y, sample_of=sample, segment_ptr=segment_ptr,
-                              band_edges=edges, bounds=bounds, local_x=features,
-                              one_per_sample=features)
     params = SimpleNamespace(test_type=test_type, test_width=width, n_tests=n_tests,
                              min_samples_split=2, max_depth=-1, max_retries=2)
     return _builder.build_tree(objects, target, weight, params, seed)
@@ -71,8 +67,10 @@ def main():
                 _predictor._set_simd(simd)
                 # one output, then two (multi-output sums)
                 targets = target if seed_outputs(case) == 1 else np.column_stack([target, weight])
-                trees = [_tree.BoxTree(**grow(x, y, sample, segment_ptr, edges, targets, weight,
-                                              bounds, test_type, seed=seed)) for seed in range(3)]
+                objects = SimpleNamespace(x=x, y=y, sample_of=sample, segment_ptr=segment_ptr,
+                                          band_edges=edges, bounds=bounds)
+                trees = [_tree.BoxTree(**grow(objects, targets, weight, test_type, seed=seed))
+                         for seed in range(3)]
                 forest = _predictor.PackedForest(trees, np.arange(n_types))
                 out = np.empty((n, forest.n_outputs))
                 assert _predictor.predict_mean(forest, data, offsets, out) == (0, -1)
@@ -80,19 +78,16 @@ def main():
                 assert _predictor.apply_leaves(forest, data, offsets, leaves) == (0, -1)
                 corrupted_inputs(forest, trees, data, offsets)
             assert _rows.scan_rows(data, 3e38, 2**24)[0] == 0, case
-    # one object per sample and type: the strip-sum scoring path
+    # a feature matrix, read in place whatever its strides: the column splitter
     n, n_features = 80, 3
-    values = rng.normal(size=(n, n_features)).astype(np.float32)
-    order = np.argsort(values, axis=0, kind="stable")
-    x = np.concatenate([values[order[:, j], j] for j in range(n_features)])
-    sample = np.concatenate([order[:, j] for j in range(n_features)]).astype(np.int32)
-    segment_ptr = np.arange(0, n * n_features + 1, n).astype(np.intp)
+    values = rng.normal(size=(n, 2 * n_features)).astype(np.float32)
     bounds = np.tile(np.array([0, 0, -np.inf, np.inf], dtype=np.float32), (n_features, 1))
-    for test_type in ("classic", "random", "fixed"):
-        for targets in (rng.normal(size=n), rng.normal(size=(n, 3))):
-            grow(x, np.zeros_like(x), sample, segment_ptr, np.array([-np.inf, np.inf]), targets,
-                 np.ones(n), bounds, test_type, width=0.3, n_tests=n_features, seed=1,
-                 features=True)
+    for columns in (values[:, :n_features], values[::-1, ::2], np.asfortranarray(values[:, 1::2])):
+        for test_type in ("classic", "random", "fixed"):
+            for local_x in (True, False):
+                for targets in (rng.normal(size=n), rng.normal(size=(n, 3))):
+                    grow(SimpleNamespace(columns=columns, bounds=bounds, local_x=local_x),
+                         targets, np.ones(n), test_type, width=0.3, n_tests=300, seed=1)
     print("kernels ok")
 
 
@@ -131,9 +126,10 @@ def corrupted_inputs(forest, trees, data, offsets):
     assert raised == 6 or trees[0].node_count == 1, raised
     sample = np.array(trees[0].children_left)   # not a sample id: out of range for some
     try:
-        grow(np.zeros(len(sample), np.float32), np.zeros(len(sample), np.float32), sample,
-             [0, len(sample)], [-np.inf, np.inf], np.zeros(2), np.ones(2),
-             np.zeros((1, 4), np.float32), "fixed")
+        zeros = np.zeros(len(sample), np.float32)
+        grow(SimpleNamespace(x=zeros, y=zeros, sample_of=sample, segment_ptr=[0, len(sample)],
+                             band_edges=[-np.inf, np.inf], bounds=np.zeros((1, 4), np.float32)),
+             np.zeros(2), np.ones(2), "fixed")
     except ValueError:
         pass
     else:

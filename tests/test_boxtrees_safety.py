@@ -79,8 +79,7 @@ def _build(sample_of, segment_ptr=(0, 3), n_samples=2):
     n = len(sample_of)
     objects = SimpleNamespace(x=np.zeros(n, np.float32), y=np.zeros(n, np.float32),
                               sample_of=np.asarray(sample_of), segment_ptr=list(segment_ptr),
-                              band_edges=[-np.inf, np.inf], bounds=np.zeros((1, 4), np.float32),
-                              local_x=False, one_per_sample=False)
+                              band_edges=[-np.inf, np.inf], bounds=np.zeros((1, 4), np.float32))
     params = SimpleNamespace(test_type="fixed", test_width=1.0, n_tests=5, min_samples_split=2,
                              max_depth=-1, max_retries=1)
     return build_tree(objects, np.zeros(n_samples), np.ones(n_samples), params, 0)
@@ -208,3 +207,49 @@ def test_one_object_of_a_huge_type_id_changes_neither_accuracy_nor_memory():
     tracemalloc.stop()
     assert peak < 50 * 2**20, peak        # was gigabytes: samples x (largest id + 1)
     assert GridCounts(2).fit(huge).transform(huge).shape == (30, 2 * 2 * 2)
+
+
+def _grow_columns(columns, target, test_type="classic", local_x=True):
+    bounds = np.tile(np.array([-3, 3, -np.inf, np.inf], np.float32), (columns.shape[1], 1))
+    objects = SimpleNamespace(columns=columns, bounds=bounds, local_x=local_x)
+    params = SimpleNamespace(test_type=test_type, test_width=0.5, n_tests=30,
+                             min_samples_split=2, max_depth=-1, max_retries=1)
+    return build_tree(objects, target, np.ones(len(target)), params, 7)
+
+
+@pytest.mark.parametrize("test_type", ["classic", "random", "fixed"])
+def test_the_tree_builder_reads_a_feature_matrix_in_place_whatever_its_strides(test_type):
+    rng = np.random.default_rng(0)
+    wide = rng.normal(size=(300, 8)).astype(np.float32)
+    target = wide[:, 1] - wide[:, 5] ** 2
+    plain = np.ascontiguousarray(wide[:, 1::2])
+    for view, rows in ((wide[:, 1::2], slice(None)), (np.asfortranarray(plain), slice(None)),
+                       (wide[::-1, 1::2], slice(None, None, -1))):   # negative row stride
+        assert not view.flags.c_contiguous
+        tree = _grow_columns(view, target[rows], test_type)
+        reference = _grow_columns(np.ascontiguousarray(view), target[rows], test_type)
+        for name in NODE_ARRAYS:
+            np.testing.assert_array_equal(tree[name], reference[name])
+    with pytest.raises(ValueError, match=r"columns must have shape \(300, 4\)"):
+        _grow_columns(plain[:-1], target)
+    with pytest.raises(ValueError, match=r"columns must have shape \(300, 3\)"):
+        objects = SimpleNamespace(columns=plain, bounds=np.zeros((3, 4), np.float32), local_x=True)
+        build_tree(objects, target, np.ones(300), SimpleNamespace(
+            test_type="classic", test_width=1.0, n_tests=3, min_samples_split=2, max_depth=-1,
+            max_retries=0), 0)
+
+
+def test_fit_on_a_feature_matrix_needs_memory_for_its_samples_not_a_copy_of_the_matrix():
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(40_000, 50)).astype(np.float32)      # 8 MB
+    y = X[:, 0] - X[:, 1]
+    forest = BoxExtraTreesRegressor(2, n_tests=50, test_type="classic", min_samples_split=2000,
+                                    random_state=0, n_jobs=1)
+    tracemalloc.start()
+    forest.fit(X, y)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    # per tree: a few arrays of one number per sample (about 2 MB here; the previous design
+    # kept sorted copies of every column, three times the matrix)
+    assert peak < X.nbytes / 2, peak
+    assert forest.score(X, y) > 0.9
