@@ -44,12 +44,14 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         "test_type": [StrOptions(set(TEST_KINDS))],
         "test_width": [Interval(Real, 0, None, closed="neither")],
         "max_retries": [Interval(Integral, 0, _INT32_MAX, closed="both")],
+        "refine_tests": ["boolean"],
         "max_depth": [Interval(Integral, 0, _INT32_MAX, closed="both"), None],
         "view_bounds": ["array-like", Interval(Real, 0, None, closed="neither"), None],
     }
 
-    def _fit_trees(self, X, y, sample_weight, seeds, n_jobs=None, verbose=0):
-        """Validate the training data, set the fitted attributes and grow one tree per seed."""
+    def _fit_trees(self, X, y, sample_weight, seeds, n_jobs=None, verbose=0, bootstrap=False):
+        """Validate the training data, set the fitted attributes and grow one tree per seed
+        (with ``bootstrap``, each on its own bootstrap sample)."""
         # a feature matrix stays a matrix: its columns are indexed directly
         sets, y = self._validate_input(X, y, reset=True, requires_y=True, matrix=True)
         y = self._encode_targets(y)
@@ -68,10 +70,11 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             test_type=self.test_type, test_width=float(self.test_width), n_tests=self.n_tests,
             min_samples_split=split if isinstance(split, Integral) else max(2, ceil(split * len(sets))),
             max_depth=-1 if self.max_depth is None else self.max_depth,
-            max_retries=self.max_retries,
+            max_retries=self.max_retries, refine_tests=bool(self.refine_tests),
         )
         trees = Parallel(n_jobs=n_jobs, verbose=verbose, prefer="threads")(
-            delayed(build_tree)(objects, y, sample_weight, params, int(seed)) for seed in seeds
+            delayed(_grow_tree)(objects, y, sample_weight, params, int(seed), bootstrap)
+            for seed in seeds
         )
         return [BoxTree.from_positions(self._node_arrays(arrays), self.types_) for arrays in trees]
 
@@ -161,6 +164,17 @@ class _TreeParams:
     min_samples_split: int
     max_depth: int
     max_retries: int
+    refine_tests: bool
+
+
+def _grow_tree(objects, y, sample_weight, params, seed, bootstrap):
+    """One tree; with ``bootstrap``, on ``n`` samples drawn with replacement (each sample's
+    weight times the number of times it is drawn), the draw seeded by the tree's seed."""
+    if bootstrap:
+        n = len(sample_weight)
+        draws = np.random.default_rng([seed, 1]).integers(0, n, n)
+        sample_weight = sample_weight * np.bincount(draws, minlength=n)
+    return build_tree(objects, y, sample_weight, params, seed)
 
 
 class RegressionTargets(RegressorMixin):

@@ -15,12 +15,14 @@ grown depth first from an explicit stack: fixed 2 x 2 boxes make trees hundreds 
 deep. A feature matrix is not copied: its splitter reads it in place through each sample's
 row, and scores a node's tests column by column.
 """
+from types import SimpleNamespace
+
 import numpy as np
 
 cimport cython
 cimport numpy as cnp
 
-from libc.math cimport INFINITY
+from libc.math cimport INFINITY, isfinite, nextafterf
 from libc.limits cimport INT_MAX, UINT_MAX
 from libcpp.algorithm cimport sort
 from libcpp.utility cimport pair
@@ -124,6 +126,7 @@ cdef enum:
     SIMD_SLACK = 16  # spare slots the SIMD compactions may write past their count
     TEST_CHUNK = 256  # tests on a feature matrix drawn, then scored column by column,
     TEST_BLOCK = 4    # this many in one pass over the column's values
+    REFINE_ROUNDS = 3  # refine_tests: rounds of moving every edge, then the threshold
 
 # the data-parallel kernels used by every tree (see _simd.h)
 cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)
@@ -136,6 +139,28 @@ def _set_simd(bint enabled):
     """
     global _kernels
     _kernels = boxtrees_select_kernels(enabled)
+
+
+cdef inline coord_t _edge(const BoxTest* t, intp_t side) noexcept nogil:
+    """Edge ``side`` of a test's box: 0 xmin, 1 xmax, 2 ymin, 3 ymax."""
+    return t.xmin if side == 0 else t.xmax if side == 1 else t.ymin if side == 2 else t.ymax
+
+
+cdef inline void _set_edge(BoxTest* t, intp_t side, coord_t value) noexcept nogil:
+    if side == 0:
+        t.xmin = value
+    elif side == 1:
+        t.xmax = value
+    elif side == 2:
+        t.ymin = value
+    else:
+        t.ymax = value
+
+
+cdef inline coord_t _key(double coordinate, intp_t side) noexcept nogil:
+    """A coordinate as a key along edge ``side``: increasing outwards, so that inside the
+    edge is ``key < key(edge)`` for every side (negation is exact, and its own inverse)."""
+    return <coord_t>(-coordinate if side % 2 == 0 else coordinate)
 
 
 cdef class _Splitter:
@@ -153,6 +178,11 @@ cdef class _Splitter:
     cdef float64_t* tmp_value        # scratch of split(): one per-sample array reordered
     cdef float64_t* sums             # scratch of the scoring: per output, right then left sums
     cdef uint8* goes_right           # set by _mark_right for split()
+    cdef int32* counts               # per sample: its count of a test (zero outside use)
+    # refine_tests: move the best test's edges and threshold to where the node's data put them
+    cdef bint refine
+    cdef vector[pair[coord_t, int32]] candidates    # one edge's objects: (key, sample)
+    cdef vector[double] proxies                     # one edge's or threshold's positions
     # per sample, indexed by its current id (its position in the node order)
     cdef float64_t* target           # n_outputs per sample
     cdef float64_t* weight
@@ -188,6 +218,7 @@ cdef class _Splitter:
         self.order = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
         self.new_id = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
         self.goes_right = <uint8*>self._own(np.zeros(n_samples, dtype=np.uint8))
+        self.counts = <int32*>self._own(np.zeros(n_samples, dtype=np.int32))
         # own copies: split() reorders them
         target = np.array(target, dtype=np.float64).reshape(n_samples, -1)
         weight = np.array(weight, dtype=np.float64)
@@ -211,6 +242,7 @@ cdef class _Splitter:
         self.width = params.test_width
         self.n_tests = params.n_tests
         self.max_retries = params.max_retries
+        self.refine = params.refine_tests
         self.rng = seed
 
     cdef void* _own(self, cnp.ndarray array):
@@ -302,6 +334,91 @@ cdef class _Splitter:
         return False
 
     @cython.final
+    cdef void _refine(self, BoxTest* best) noexcept nogil:
+        """Move each finite edge of the best test, then its threshold, to the best position
+        the node's data support, for up to ``REFINE_ROUNDS`` rounds, until nothing moves.
+
+        Edges stop where the training objects stop supporting them: past the last object that
+        changes the split, more area only takes in objects that the training data never tied
+        to the target, which on larger sets would move samples at random.
+        """
+        cdef intp_t r, side
+        cdef bint moved
+        for r in range(REFINE_ROUNDS):
+            moved = False
+            for side in range(4):
+                if isfinite(_edge(best, side)):
+                    moved |= self._refine_edge(best, side)
+            moved |= self._refine_threshold(best)
+            if not moved:
+                break
+
+    @cython.final
+    cdef bint _refine_edge(self, BoxTest* best, intp_t side) noexcept nogil:
+        """Sweep one edge of ``best`` (0: xmin, 1: xmax, 2: ymin, 3: ymax) from outside the
+        node's objects inwards past them one at a time, scoring every position at the test's
+        threshold; keep the tightest of the best, the edge midway between the objects on
+        either side of it. Returns whether the edge moved."""
+        cdef intp_t m = self._collect(best, side), p, j, k, n_outputs = self.n_outputs
+        cdef intp_t n_right = 0              # exact, where wr (added, then subtracted) is not
+        cdef int32 z = best.threshold, s, c
+        cdef double wr = 0.0, top = -INFINITY
+        cdef BoxTest trial = best[0]
+        cdef coord_t inner, outer, edge, old = _key(_edge(best, side), side)
+        if m == 0:
+            return False
+        sort(self.candidates.begin(), self.candidates.begin() + m)   # by key, ascending
+        self.proxies.resize(m)
+        for k in range(n_outputs):
+            self.sums[k] = 0.0
+        # every candidate inside: its sample's count, and the right child at threshold z
+        for j in range(m):
+            s = self.candidates[j].second
+            self.counts[s] += 1
+            if self.counts[s] == z:
+                n_right += 1
+                wr += self.weight[s]
+                for k in range(n_outputs):
+                    self.sums[k] += self.weighted_target[s * n_outputs + k]
+        # position p: the p outermost candidates (the largest keys) are outside
+        for p in range(m):
+            j = m - 1 - p
+            if p > 0:
+                s = self.candidates[j + 1].second
+                c = self.counts[s]
+                self.counts[s] = c - 1
+                if c == z:
+                    n_right -= 1
+                    wr -= self.weight[s]
+                    for k in range(n_outputs):
+                        self.sums[k] -= self.weighted_target[s * n_outputs + k]
+            self.proxies[p] = -INFINITY
+            if p > 0 and self.candidates[j + 1].first == self.candidates[j].first:
+                continue                         # no edge fits between equal keys
+            if (0 < n_right < self.end - self.start
+                    and self._score(&trial, self.w_sum - wr, wr, True)):
+                self.proxies[p] = trial.proxy
+                top = max(top, trial.proxy)
+        self.counts[self.candidates[0].second] = 0   # the one object still inside
+        if top == -INFINITY:
+            return False
+        p = m - 1
+        while self.proxies[p] < top - self.tie:
+            p -= 1
+        inner = self.candidates[m - 1 - p].first
+        if p > 0:
+            outer = self.candidates[m - p].first
+        else:                    # nothing outside: keep the old edge if it is out there
+            outer = old if old > inner else _key(self.region[4 * best.object_type + side], side)
+            if not outer > inner:
+                outer = nextafterf(inner, INFINITY)
+        edge = <coord_t>((<double>inner + <double>outer) / 2)
+        if not inner < edge <= outer:
+            edge = outer
+        _set_edge(best, side, _key(edge, side))
+        return edge != old
+
+    @cython.final
     cdef intp_t split(self, const BoxTest* best, intp_t* right_lo) noexcept nogil:
         """Send the node's samples and objects left or right; return the first right sample.
 
@@ -338,6 +455,16 @@ cdef class _Splitter:
         """Follow the renumbering of split() (``order``, ``new_id``) in the objects' arrays,
         and leave ``goes_right`` all zero."""
 
+    cdef intp_t _collect(self, const BoxTest* t, intp_t side) noexcept nogil:
+        """Fill ``candidates`` with the node's objects of the test's type that lie inside its
+        box with edge ``side`` removed, as (key along that edge, sample); return how many."""
+        return 0
+
+    cdef bint _refine_threshold(self, BoxTest* best) noexcept nogil:
+        """Re-pick the threshold of the (refined) best test as the best one on the node's
+        counts (ties: the smallest) and set its proxy; return whether it changed."""
+        return False
+
     @cython.final
     cdef void _reorder(self, float64_t* values, intp_t width) noexcept nogil:
         """Move the node's rows of a per-sample array (``width`` values per sample) to the
@@ -362,7 +489,6 @@ cdef class _ObjectSplitter(_Splitter):
     cdef coord_t* tmp_y
     cdef int32* tmp_sid
     cdef int32* strip                # sample ids of the objects of a strip inside the box
-    cdef int32* counts
     cdef int32* hits
     cdef intp_t n_hit                # of the test being applied by split()
     cdef const float64_t* edges      # band edges, n_bands + 1, from -inf to +inf
@@ -388,7 +514,6 @@ cdef class _ObjectSplitter(_Splitter):
         self.tmp_y = <coord_t*>self._own(np.empty(max_segment, dtype=np.float32))
         self.tmp_sid = <int32*>self._own(np.empty(max_segment, dtype=np.int32))
         self.strip = <int32*>self._own(np.empty(max_segment + SIMD_SLACK, dtype=np.int32))
-        self.counts = <int32*>self._own(np.zeros(n_samples, dtype=np.int32))
         # one spare slot: the branch-free scatter in count() stores a sample id before it
         # knows whether the sample is new, so with every sample hit it writes one past them
         self.hits = <int32*>self._own(np.empty(n_samples + 1, dtype=np.int32))
@@ -513,7 +638,60 @@ cdef class _ObjectSplitter(_Splitter):
                     found = True
             if found:
                 break
+        if found and self.refine:
+            self._refine(best)
         return found
+
+    cdef intp_t _collect(self, const BoxTest* t, intp_t side) noexcept nogil:
+        cdef intp_t g, j, m = 0
+        cdef coord_t x, y
+        cdef bint inside
+        self.candidates.resize(self.type_size[t.object_type])
+        for g in range(t.object_type * self.n_bands, (t.object_type + 1) * self.n_bands):
+            for j in range(self.lo[g], self.hi[g]):
+                x, y = self.xs[j], self.ys[j]
+                inside = ((side == 0 or t.xmin < x) and (side == 1 or x < t.xmax)
+                          and (side == 2 or t.ymin < y) and (side == 3 or y < t.ymax))
+                if inside:
+                    self.candidates[m] = pair[coord_t, int32](
+                        _key(x if side < 2 else y, side), self.sid[j])
+                    m += 1
+        return m
+
+    cdef bint _refine_threshold(self, BoxTest* best) noexcept nogil:
+        cdef int32 cmax, cmin = 0, z, old = best.threshold, s
+        cdef intp_t n_hit = self.count(best, &cmax), j, k, n_outputs = self.n_outputs
+        cdef vector[double] hist_w, hist_wy     # per count: the samples' weights and sums
+        cdef double wr = 0.0
+        cdef BoxTest trial = best[0]
+        hist_w.resize(cmax + 1)
+        hist_wy.resize((cmax + 1) * n_outputs)
+        if n_hit == self.end - self.start:
+            cmin = cmax
+            for j in range(n_hit):
+                cmin = min(cmin, self.counts[self.hits[j]])
+        for j in range(n_hit):
+            s = self.hits[j]
+            hist_w[self.counts[s]] += self.weight[s]
+            for k in range(n_outputs):
+                hist_wy[self.counts[s] * n_outputs + k] += self.weighted_target[s * n_outputs + k]
+            self.counts[s] = 0
+        self.proxies.resize(cmax + 1)
+        for k in range(n_outputs):
+            self.sums[k] = 0.0
+        for z in range(cmax, cmin, -1):          # the right child: counts >= z
+            wr += hist_w[z]
+            for k in range(n_outputs):
+                self.sums[k] += hist_wy[z * n_outputs + k]
+            # (both children have samples: some count z or more, some less than z)
+            self.proxies[z] = trial.proxy if self._score(&trial, self.w_sum - wr, wr, True) \
+                else -INFINITY
+        # the best threshold, the smallest among ties
+        best.proxy = -INFINITY
+        for z in range(cmin + 1, cmax + 1):
+            if self.proxies[z] > best.proxy + self.tie:
+                best.threshold, best.proxy = z, self.proxies[z]
+        return best.threshold != old
 
     cdef void _mark_right(self, const BoxTest* best) noexcept nogil:
         cdef int32 cmax, s
@@ -555,12 +733,15 @@ cdef class _ColumnSplitter(_Splitter):
     def __cinit__(self, objects, const intp_t[::1] segment_ptr, target, weight, params,
                   uint64 seed):
         self.columns = objects.columns
-        if self.columns.shape[0] != self.n_samples or self.columns.shape[1] != self.n_types:
+        rows = getattr(objects, "rows", None)
+        rows = np.arange(self.n_samples) if rows is None else np.array(rows)
+        if (self.columns.shape[1] != self.n_types or rows.shape != (self.n_samples,)
+                or (rows.size and (rows.min() < 0 or rows.max() >= self.columns.shape[0]))):
             raise ValueError(f"columns must have shape ({self.n_samples}, {self.n_types}), "
                              f"one row per sample and one column per type of bounds")
         self.row_stride = self.columns.strides[0] // sizeof(coord_t)
         self.column_stride = self.columns.strides[1] // sizeof(coord_t)
-        self.rows = <int32*>self._own(np.arange(self.n_samples, dtype=np.int32))
+        self.rows = <int32*>self._own(rows.astype(np.int32))
         self.tmp_rows = <int32*>self._own(np.empty(self.n_samples, dtype=np.int32))
         self.values = <coord_t*>self._own(np.empty(self.n_samples, dtype=np.float32))
         self.node_min = <coord_t*>self._own(np.empty(self.n_types, dtype=np.float32))
@@ -638,7 +819,22 @@ cdef class _ColumnSplitter(_Splitter):
                         found = True
             if found:
                 break
+        if found and self.refine:
+            self._gather(best.object_type)
+            self._refine(best)
         return found
+
+    cdef intp_t _collect(self, const BoxTest* t, intp_t side) noexcept nogil:
+        """(The gathered values are the best test's column.)"""
+        cdef intp_t i, m = 0
+        cdef coord_t v
+        self.candidates.resize(self.end - self.start)
+        for i in range(self.start, self.end):
+            v = self.values[i]
+            if (side == 0 or t.xmin < v) and (side == 1 or v < t.xmax):
+                self.candidates[m] = pair[coord_t, int32](_key(v, side), <int32>i)
+                m += 1
+        return m
 
     cdef void _gather(self, intp_t column) noexcept nogil:
         """Copy the node's values of ``column`` to ``values[start:end]``."""
@@ -780,6 +976,8 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, vector[float64_t]* valu
         if not splitter.find_best(&best):
             continue
         mid = splitter.split(&best, right_lo.data())
+        if mid == rec.start or mid == rec.end:   # (never: every test kept splits the node)
+            continue
         nodes[0][node_id].object_type = <int32>best.object_type
         nodes[0][node_id].box[0] = best.xmin
         nodes[0][node_id].box[1] = best.xmax
@@ -820,7 +1018,7 @@ def build_tree(objects, target, weight, params, uint64 seed):
     target : array of shape (n_samples,) or (n_samples, n_outputs)
         Targets (encoded class indicators for a classifier); ``n_samples < 2**31``.
     weight : array of shape (n_samples,)
-        Strictly positive sample weights.
+        Non-negative sample weights; the tree grows on the samples of positive weight.
     params : object
         ``test_type, test_width, n_tests, min_samples_split, max_depth, max_retries`` as in
         ``BoxExtraTreesRegressor``; ``min_samples_split`` is a number of samples and
@@ -842,9 +1040,18 @@ def build_tree(objects, target, weight, params, uint64 seed):
         raise ValueError("bounds must be (n_types, 4)")
     if not 0 < params.n_tests <= UINT_MAX or params.max_retries < 0:
         raise ValueError(f"n_tests must be in [1, {UINT_MAX}] and max_retries >= 0")
+    weight = np.array(weight, dtype=np.float64)
+    if not (weight >= 0).all() or not (weight > 0).any():
+        raise ValueError("weights must be non-negative and not all zero")
+    # a tree grows on the samples of positive weight only, as scikit-learn's do
+    kept = np.flatnonzero(weight > 0) if (weight == 0).any() else None
+    if kept is not None:
+        target, weight = np.asarray(target)[kept], weight[kept]
     cdef _Splitter splitter
     if getattr(objects, "columns", None) is not None:
         segment_ptr = np.zeros(1, dtype=np.intp)        # no segments
+        objects = SimpleNamespace(columns=objects.columns, bounds=objects.bounds,
+                                  local_x=objects.local_x, rows=kept)
         splitter = _ColumnSplitter(objects, segment_ptr, target, weight, params, seed)
     else:
         segment_ptr = np.array(objects.segment_ptr, dtype=np.intp)
@@ -854,6 +1061,8 @@ def build_tree(objects, target, weight, params, uint64 seed):
                              "n_types * n_bands + 1 entries")
         if scan_offsets(segment_ptr, n_objects) != -1:
             raise ValueError(f"segment_ptr must rise from 0 to the number of objects, {n_objects}")
+        if kept is not None:
+            objects, segment_ptr = _objects_of(objects, segment_ptr, kept, n_samples)
         splitter = _ObjectSplitter(objects, segment_ptr, target, weight, params, seed)
     cdef vector[Node] nodes
     cdef vector[float64_t] values
@@ -867,3 +1076,21 @@ def build_tree(objects, target, weight, params, uint64 seed):
     value = np.asarray(<float64_t[:n * splitter.n_outputs]>values.data()).reshape(n, -1)
     arrays["value"] = value.ravel().copy() if np.ndim(target) == 1 else value.copy()
     return arrays
+
+
+def _objects_of(objects, segment_ptr, kept, n_samples):
+    """The objects of samples ``kept`` (sorted ids), renumbered ``0..len(kept)``, and their
+    segment offsets."""
+    sample_of = np.asarray(objects.sample_of, dtype=np.intp)
+    if not np.shape(objects.x) == np.shape(objects.y) == sample_of.shape == (segment_ptr[-1],):
+        raise ValueError("x, y and sample_of must have one entry per object")
+    if sample_of.size and (sample_of.min() < 0 or sample_of.max() >= n_samples):
+        raise ValueError(f"sample_of must hold sample ids in [0, {n_samples})")
+    new_id = np.full(n_samples, -1, dtype=np.intp)
+    new_id[kept] = np.arange(len(kept))
+    keep = new_id[sample_of] >= 0
+    segment = np.repeat(np.arange(len(segment_ptr) - 1), np.diff(segment_ptr))
+    ptr = np.concatenate([[0], np.cumsum(np.bincount(segment[keep], minlength=len(segment_ptr) - 1))])
+    return SimpleNamespace(x=np.asarray(objects.x)[keep], y=np.asarray(objects.y)[keep],
+                           sample_of=new_id[sample_of[keep]], band_edges=objects.band_edges,
+                           bounds=objects.bounds), ptr.astype(np.intp)

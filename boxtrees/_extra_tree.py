@@ -40,6 +40,7 @@ class _SingleTree(BaseBoxTrees):
         max_retries=10,
         max_depth=None,
         view_bounds=None,
+        refine_tests=False,
         random_state=None,
     ):
         self.n_tests = n_tests
@@ -49,6 +50,7 @@ class _SingleTree(BaseBoxTrees):
         self.max_retries = max_retries
         self.max_depth = max_depth
         self.view_bounds = view_bounds
+        self.refine_tests = refine_tests
         self.random_state = random_state
 
     @_fit_context(prefer_skip_nested_validation=True)
@@ -106,12 +108,12 @@ class BoxExtraTreeRegressor(RegressionTargets, _SingleTree):
     """One Extra-Tree over sets of 2D objects, with box-count node tests.
 
     The trees of `BoxExtraTreesRegressor` (its ``estimators_``) are of this class; fitting one
-    with the ``random_state`` a forest gave its tree grows that same tree. See
-    `BoxExtraTreesRegressor` for the test, the split rule and the inputs.
+    with the ``random_state`` a forest gave its tree grows that same tree (unless the forest
+    bootstraps). See `BoxExtraTreesRegressor` for the test, the split rule and the inputs.
 
     Parameters
     ----------
-    n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds
+    n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, refine_tests
         As in `BoxExtraTreesRegressor`.
     random_state : int, RandomState instance or None, default=None
         An int in ``[0, 2**63)`` is the seed of the tree's random generator; a RandomState
@@ -154,7 +156,7 @@ class BoxExtraTreeClassifier(ClassificationTargets, _SingleTree):
 
     Parameters
     ----------
-    n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, random_state
+    n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, refine_tests, random_state
         As in `BoxExtraTreeRegressor`.
 
     Attributes

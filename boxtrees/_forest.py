@@ -24,6 +24,7 @@ class _Forest(BaseBoxTrees):
     _parameter_constraints = {
         **BaseBoxTrees._parameter_constraints,
         "n_estimators": [Interval(Integral, 1, _INT32_MAX, closed="both")],
+        "bootstrap": ["boolean"],
         "n_jobs": [Integral, None],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
@@ -40,6 +41,8 @@ class _Forest(BaseBoxTrees):
         max_retries=10,
         max_depth=None,
         view_bounds=None,
+        refine_tests=False,
+        bootstrap=False,
         n_jobs=None,
         random_state=None,
         verbose=0,
@@ -52,6 +55,8 @@ class _Forest(BaseBoxTrees):
         self.max_retries = max_retries
         self.max_depth = max_depth
         self.view_bounds = view_bounds
+        self.refine_tests = refine_tests
+        self.bootstrap = bootstrap
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.verbose = verbose
@@ -77,7 +82,8 @@ class _Forest(BaseBoxTrees):
         """
         rng = check_random_state(self.random_state)
         seeds = rng.randint(np.iinfo(np.int64).max, size=self.n_estimators, dtype=np.int64)
-        trees = self._fit_trees(X, y, sample_weight, seeds, self.n_jobs, self.verbose)
+        trees = self._fit_trees(X, y, sample_weight, seeds, self.n_jobs, self.verbose,
+                                bootstrap=self.bootstrap)
         params = {name: getattr(self, name) for name in self._tree_class._get_param_names()
                   if name != "random_state"}
         fitted = {name: value for name, value in self.__dict__.items() if name in _SHARED_FITTED}
@@ -158,8 +164,8 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
     lie strictly inside the box ``(xmin, xmax) x (ymin, ymax)``. Each node keeps the best of
     ``n_tests`` random tests, scored by the weighted variance of the two children; the count
     threshold ``z`` is drawn uniformly among the integers in ``(min count, max count]`` of the
-    node. Trees are grown on the full data (no bootstrap) and the forest predicts the mean of
-    its trees.
+    node. Trees are grown on the full data (unless ``bootstrap``) and the forest predicts the
+    mean of its trees.
 
     ``X`` may also be a 2D feature matrix: column ``j`` is then read as a one-dimensional object
     of type ``j`` and the tests are intervals on one column, drawn within the node's range of
@@ -196,6 +202,19 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         Sampling region ``(xmin, xmax, ymin, ymax)``, or a half-width ``r`` for ``[-r, r]^2``.
         None: the bounding box of the training objects (for a feature matrix: each node's
         range of the tested column).
+    refine_tests : bool, default=False
+        Refine the best of each node's tests on the node's training objects: each finite edge
+        of its box is swept across the objects and moved to the tightest position of the best
+        score, then the threshold is re-picked as the best one, for up to 3 rounds. Boxes then
+        stop where the training data stop supporting them, so that on sets larger than those
+        seen at fit the extra background objects do not cross the thresholds. Use it (with
+        ``bootstrap=True``) when the sets at prediction may be larger than at training; see
+        the set-size study in ``docs/set_sizes.md``. It costs a sort of the node's objects
+        of the tested type per refined edge.
+    bootstrap : bool, default=False
+        Grow each tree on a bootstrap sample (``n_samples`` draws with replacement, as
+        weights), as scikit-learn's ``bootstrap``; with ``refine_tests`` it makes the refined
+        edges differ from tree to tree, so that the forest averages out their errors.
     n_jobs : int, default=None
         Number of parallel jobs for ``fit`` (over trees) and large ``predict`` / ``apply``
         calls (over samples). None means 1 unless in a ``joblib.parallel_backend`` context; -1
@@ -271,7 +290,7 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
 
     Parameters
     ----------
-    n_estimators, n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, n_jobs, random_state, verbose
+    n_estimators, n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, refine_tests, bootstrap, n_jobs, random_state, verbose
         As in `BoxExtraTreesRegressor`.
 
     Attributes

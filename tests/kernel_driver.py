@@ -24,10 +24,11 @@ _tree = importlib.import_module("boxtrees._tree")
 _NODE_ARRAYS = _builder.NODE_FIELDS
 
 
-def grow(objects, target, weight, test_type, width=0.7, n_tests=20, seed=0):
+def grow(objects, target, weight, test_type, width=0.7, n_tests=20, seed=0, refine=False):
     """One tree from the builder, with small parameters."""
     params = SimpleNamespace(test_type=test_type, test_width=width, n_tests=n_tests,
-                             min_samples_split=2, max_depth=-1, max_retries=2)
+                             min_samples_split=2, max_depth=-1, max_retries=2,
+                             refine_tests=refine)
     return _builder.build_tree(objects, target, weight, params, seed)
 
 
@@ -69,7 +70,10 @@ def main():
                 targets = target if seed_outputs(case) == 1 else np.column_stack([target, weight])
                 objects = SimpleNamespace(x=x, y=y, sample_of=sample, segment_ptr=segment_ptr,
                                           band_edges=edges, bounds=bounds)
-                trees = [_tree.BoxTree(**grow(objects, targets, weight, test_type, seed=seed))
+                # refined tests on the first tree; zero weights drop samples in the third
+                some_zero = weight * (np.arange(n) % 3 != 1)
+                trees = [_tree.BoxTree(**grow(objects, targets, some_zero if seed == 2 else weight,
+                                              test_type, seed=seed, refine=seed == 0))
                          for seed in range(3)]
                 forest = _predictor.PackedForest(trees, np.arange(n_types))
                 out = np.empty((n, forest.n_outputs))
@@ -86,8 +90,11 @@ def main():
         for test_type in ("classic", "random", "fixed"):
             for local_x in (True, False):
                 for targets in (rng.normal(size=n), rng.normal(size=(n, 3))):
-                    grow(SimpleNamespace(columns=columns, bounds=bounds, local_x=local_x),
-                         targets, np.ones(n), test_type, width=0.3, n_tests=300, seed=1)
+                    for refine in (False, True):
+                        weight = rng.integers(0, 3, n).astype(float)  # zeros drop samples
+                        grow(SimpleNamespace(columns=columns, bounds=bounds, local_x=local_x),
+                             targets, weight, test_type, width=0.3, n_tests=300, seed=1,
+                             refine=refine)
     print("kernels ok")
 
 

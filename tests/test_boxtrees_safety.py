@@ -81,7 +81,7 @@ def _build(sample_of, segment_ptr=(0, 3), n_samples=2):
                               sample_of=np.asarray(sample_of), segment_ptr=list(segment_ptr),
                               band_edges=[-np.inf, np.inf], bounds=np.zeros((1, 4), np.float32))
     params = SimpleNamespace(test_type="fixed", test_width=1.0, n_tests=5, min_samples_split=2,
-                             max_depth=-1, max_retries=1)
+                             max_depth=-1, max_retries=1, refine_tests=False)
     return build_tree(objects, np.zeros(n_samples), np.ones(n_samples), params, 0)
 
 
@@ -213,7 +213,7 @@ def _grow_columns(columns, target, test_type="classic", local_x=True):
     bounds = np.tile(np.array([-3, 3, -np.inf, np.inf], np.float32), (columns.shape[1], 1))
     objects = SimpleNamespace(columns=columns, bounds=bounds, local_x=local_x)
     params = SimpleNamespace(test_type=test_type, test_width=0.5, n_tests=30,
-                             min_samples_split=2, max_depth=-1, max_retries=1)
+                             min_samples_split=2, max_depth=-1, max_retries=1, refine_tests=False)
     return build_tree(objects, target, np.ones(len(target)), params, 7)
 
 
@@ -236,7 +236,7 @@ def test_the_tree_builder_reads_a_feature_matrix_in_place_whatever_its_strides(t
         objects = SimpleNamespace(columns=plain, bounds=np.zeros((3, 4), np.float32), local_x=True)
         build_tree(objects, target, np.ones(300), SimpleNamespace(
             test_type="classic", test_width=1.0, n_tests=3, min_samples_split=2, max_depth=-1,
-            max_retries=0), 0)
+            max_retries=0, refine_tests=False), 0)
 
 
 def test_fit_on_a_feature_matrix_needs_memory_for_its_samples_not_a_copy_of_the_matrix():
