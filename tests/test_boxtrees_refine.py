@@ -88,3 +88,17 @@ def test_bad_values_are_rejected_with_the_parameter_name():
     for name in ("refine_tests", "bootstrap"):
         with pytest.raises(ValueError, match=name):
             BoxExtraTreesRegressor(**{name: "yes"}).fit(X, y)
+
+
+def test_bench_sets_writes_its_table_json_and_plot(tmp_path, capsys):
+    import json
+
+    from benchmarks import bench_sets
+
+    bench_sets.main(["--quick", "--tasks", "presence", "--n-jobs", "1", "--out", str(tmp_path)])
+    report = json.loads((tmp_path / "bench_sets.json").read_text())
+    assert (tmp_path / "bench_sets.png").stat().st_size > 0
+    rows = {row["model"]: row["accuracy"] for row in report["rows"]}
+    refined = rows["box forest (fixed, refine_tests=true,bootstrap=true)"]
+    assert refined["300"] > rows["box forest (fixed)"]["300"] and refined["300"] > 0.95
+    assert "| presence | box forest (fixed) |" in report["markdown"] in capsys.readouterr().out
