@@ -863,23 +863,18 @@ cdef class _ColumnSplitter(_Splitter):
             if k < n:
                 lo[k], hi[k] = tests[k].xmin, tests[k].xmax
             n_in[k], w_in[k], wy[k] = 0, 0.0, 0.0
-        if n_outputs == 1 and self.unit_weights:   # the sum of the weights is the count
+        # one output: its sums here; several: theirs below, test by test (the weights then
+        # stand in for the target here, unused)
+        cdef const float64_t* target = self.weighted_target if n_outputs == 1 else self.weight
+        if self.unit_weights:    # the sum of the weights is the count
             for i in range(self.start, self.end):
                 v = values[i]
                 for k in range(TEST_BLOCK):
                     inside = (lo[k] < v) & (v < hi[k])
                     n_in[k] += <intp_t>inside
-                    wy[k] += inside * self.weighted_target[i]
+                    wy[k] += inside * target[i]
             for k in range(TEST_BLOCK):
                 w_in[k] = <double>n_in[k]
-        elif n_outputs == 1:
-            for i in range(self.start, self.end):
-                v = values[i]
-                for k in range(TEST_BLOCK):
-                    inside = (lo[k] < v) & (v < hi[k])
-                    n_in[k] += <intp_t>inside
-                    w_in[k] += inside * self.weight[i]
-                    wy[k] += inside * self.weighted_target[i]
         else:
             for i in range(self.start, self.end):
                 v = values[i]
@@ -887,6 +882,7 @@ cdef class _ColumnSplitter(_Splitter):
                     inside = (lo[k] < v) & (v < hi[k])
                     n_in[k] += <intp_t>inside
                     w_in[k] += inside * self.weight[i]
+                    wy[k] += inside * target[i]
         for k in range(n):
             tests[k].threshold = 0
             if n_in[k] == 0 or n_in[k] == self.end - self.start:
