@@ -5,7 +5,10 @@ Workloads (thesis parameters K=500, n_min=30, M=30):
   TW=1 boxes and with random boxes, vs sklearn ET on GridCounts(10) features;
 - a dense 10,000 x 20 regression: our forest on the feature matrix (classic tests, K = number
   of features) vs sklearn ET with max_features=all, same trees and n_min;
-- single-sample predict latency of a 30-tree forest.
+- single-sample predict latency of a 30-tree forest;
+- peak memory (RSS) of fitting 2 trees on a 200,000 x 50 float32 matrix with default
+  parameters, ours and sklearn's, each in a fresh interpreter, beside the interpreter with
+  the libraries and the data alone.
 
 Prints a table, writes ``bench_trees.json`` and ``bench_trees.png`` under ``--out``.
 
@@ -15,6 +18,8 @@ import argparse
 import json
 import os
 import platform
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -85,6 +90,35 @@ def single_sample_latency(forest, n_calls=2000):
     return float(np.median(times) * 1e6)
 
 
+_MEMORY_SCRIPT = """
+import resource, sys
+import numpy as np
+from boxtrees import BoxExtraTreesRegressor
+from sklearn.ensemble import ExtraTreesRegressor
+rng = np.random.default_rng(0)
+X = np.empty((200_000, 50), dtype=np.float32)
+for start in range(0, len(X), 10_000):   # no float64 copy of the whole matrix
+    X[start:start + 10_000] = rng.normal(size=(10_000, 50))
+y = X[:, 0] + rng.normal(size=len(X))
+model = {"ours": lambda: BoxExtraTreesRegressor(2, n_jobs=1, random_state=0),
+         "sklearn": lambda: ExtraTreesRegressor(2, n_jobs=1, random_state=0)}.get(sys.argv[1])
+if model is not None:
+    model().fit(X, y)
+print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)   # KiB on Linux
+"""
+
+
+def dense_fit_memory():
+    """Peak RSS in MB of a fresh interpreter holding the libraries and the 200,000 x 50
+    matrix ("data"), and of one that also fits 2 trees on it, ours and sklearn's."""
+    peaks = {}
+    for who in ("data", "ours", "sklearn"):
+        done = subprocess.run([sys.executable, "-c", _MEMORY_SCRIPT, who], check=True,
+                              capture_output=True, text=True)
+        peaks[who] = int(done.stdout.split()[-1]) / 1024
+    return peaks
+
+
 def plot(rows, path):
     import matplotlib
 
@@ -131,6 +165,9 @@ def main():
     rows += dense_workload(args.n_jobs)
     latency_us = single_sample_latency(forest)
     print(f"single-sample predict, 30 fixed-box trees: {latency_us:.1f} us (median)")
+    memory = dense_fit_memory()
+    print(f"dense fit peak RSS, 200,000 x 50, 2 trees: ours {memory['ours']:.0f} MB, sklearn "
+          f"{memory['sklearn']:.0f} MB (libraries and data alone: {memory['data']:.0f} MB)")
 
     def ratio(model_a, model_b, n, key="fit_s"):
         a = next(r for r in rows if r["model"] == model_a and r["n_samples"] == n)
@@ -143,11 +180,14 @@ def main():
         "object_fit_speedup_n": n_big,
         "dense_fit_speedup_vs_sklearn": ratio("box forest (classic) on matrix", "sklearn ET on matrix", 10000),
         "single_sample_predict_us": latency_us,
+        "dense_fit_peak_rss_mb": memory,
     }
     print(f"\nobject-set fit speed-up vs sklearn-on-grid at N={n_big}: "
           f"{summary['object_fit_speedup_vs_sklearn_grid']:.1f}x (target >= 5x at N=20,000)")
     print(f"dense fit speed-up vs sklearn: {summary['dense_fit_speedup_vs_sklearn']:.2f}x (target >= 1x)")
     print(f"single-sample predict: {latency_us:.1f} us (target <= 50 us)")
+    print(f"dense fit memory: {memory['ours']:.0f} MB vs sklearn's {memory['sklearn']:.0f} MB "
+          "(target: at most sklearn's)")
     load = os.getloadavg()[1]
     print(f"load average over the last 5 minutes: {load:.1f} on {os.cpu_count()} cores "
           "(other processes slow both sides)")
