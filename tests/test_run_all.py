@@ -35,8 +35,11 @@ def test_registry_covers_every_thesis_figure_once():
     figures = [e.figure for e in EXPERIMENTS if e.figure != "extra"]
     assert sorted(figures) == sorted(["A.1", "A.2", "A.3", "A.4", "A.5", "3.1", "3.2", "3.3",
                                       "3.4", "3.5", "3.6", "3.8", "3.9", "3.10"])
-    assert {e.name for e in EXPERIMENTS if e.figure == "extra"} == {"keep_data", "dqn",
-                                                                    "attention"}
+    assert {e.name for e in EXPERIMENTS if e.figure == "extra"} == {
+        "keep_data", "dqn", "attention", "search_dqn_grid", "search_dqn_objects",
+        "search_ppo_objects"}
+    assert {e.name for e in EXPERIMENTS if e.on_demand} == {
+        "search_dqn_grid", "search_dqn_objects", "search_ppo_objects"}
     assert len(REGISTRY) == len(EXPERIMENTS)
 
 
@@ -52,13 +55,17 @@ def _rule_labels(rule):
 
 @pytest.mark.parametrize("experiment", EXPERIMENTS, ids=lambda e: e.name)
 def test_every_setting_resolves_and_every_rule_names_real_settings(experiment):
-    assert experiment.kind in {"fqi", "rmse", "dqn", "attention"}
+    kinds = {"fqi", "rmse", "dqn", "sb3", "attention"}
+    assert experiment.kind in kinds
     for label in experiment.settings:
         owner, owner_label = resolve(experiment, label)
         params = owner.params(owner_label)
-        assert params["kind"] in {"fqi", "rmse", "dqn", "attention"}
+        assert params["kind"] in kinds
         assert params["env_id"].startswith("ObjectWorld")
-        if params.get("model", "box") == "box" and params["kind"] != "dqn":
+        if params["kind"] == "sb3":
+            assert {"algo", "observation", "hyperparams", "step_scale"} <= set(params)
+            assert "gamma" in params["hyperparams"]      # searched, never SB3's default
+        elif params.get("model", "box") == "box" and params["kind"] != "dqn":
             assert {"test_type", "n_estimators", "n_tests", "min_samples_split"} <= set(params)
     for rule in experiment.findings:
         assert set(_rule_labels(rule)) <= set(experiment.settings), rule
@@ -258,17 +265,20 @@ def tiny_run(tmp_path_factory):
     return out, report
 
 
+DEFAULT_EXPERIMENTS = [e for e in EXPERIMENTS if not e.on_demand]
+
+
 def test_every_experiment_runs_end_to_end(tiny_run):
     out, report = tiny_run
-    for experiment in EXPERIMENTS:
+    for experiment in DEFAULT_EXPERIMENTS:
         assert (out / figure_name(experiment)).stat().st_size > 5000, experiment.name
         assert (out / f"{experiment.name}.csv").exists()
     text = report.read_text()
-    for experiment in EXPERIMENTS:
-        assert f'<a id="{experiment.name}"></a>' in text
+    for experiment in EXPERIMENTS:   # the searches run (and are reported) only when named
+        assert (f'<a id="{experiment.name}"></a>' in text) != experiment.on_demand
     assert "Partial" not in text
     summary = json.loads((out / "summary.json").read_text())
-    assert set(summary["experiments"]) == set(REGISTRY)
+    assert set(summary["experiments"]) == {e.name for e in DEFAULT_EXPERIMENTS}
     fqi = summary["experiments"]["representations"]["settings"]["fixed TW=1"]
     assert fqi["n_runs"] == 1 and np.isfinite(fqi["score"])
     record = json.loads(unit_path(out, TINY, "representations", "fixed TW=1", 0).read_text())
@@ -637,3 +647,30 @@ def test_bench_fqi_and_sweep_fqi_runs_are_registry_settings():
         assert params["kind"] == "fqi" and set(changes) <= {"resample_every", "gamma"}
     assert sweep_fqi._params(sweep_fqi.REGIMES["offline"], 10)["resample_every"] is None
     assert sweep_fqi._params(sweep_fqi.REGIMES["keep"], 10)["n_estimators"] == 10
+
+
+def test_baseline_searches_run_when_named_with_their_own_seeds_and_curves(tmp_path):
+    report = main(["--budget", "tiny", "--only", "search_dqn_grid,search_dqn_objects",
+                   "--out", str(tmp_path), "--no-progress"])
+    search = REGISTRY["search_dqn_objects"]
+    assert len(search.settings) == 8 and search.seeds == 2
+    for name in ("search_dqn_grid", "search_dqn_objects"):
+        for label in REGISTRY[name].settings:
+            for seed in (0, 1):
+                result = json.loads(unit_path(tmp_path, TINY, name, label, seed).read_text())["result"]
+                steps = [s for s, _ in result["curve"]]
+                assert len(steps) == 4 and steps == sorted(steps)
+                assert result["curve"][-1] == [result["total_timesteps"], result["reward"]]
+        assert f'<a id="{name}"></a>' in report.read_text()
+    assert '<a id="search_ppo_objects"></a>' not in report.read_text()
+
+
+def test_a_ppo_run_on_the_objects_with_attention():
+    from benchmarks.reproduce.units import run_unit
+
+    params = {**REGISTRY["search_ppo_objects"].params("CartPole, gamma 0.9, attention"),
+              "hyperparams": {"n_envs": 2, "n_steps": 32, "batch_size": 32, "n_epochs": 1,
+                              "gamma": 0.9}, "step_scale": 1.0, "max_objects": 32}
+    result = run_unit(params, TINY, 0, TINY.samples)
+    assert params["attention"] and result["total_timesteps"] >= TINY.dqn_steps
+    assert len(result["curve"]) == 4 and np.isfinite(result["reward"])

@@ -156,7 +156,7 @@ def main(argv=None):
         parser.error(f"argument --jobs: not allowed with argument {option} (the cluster's "
                      f"workers run the units)")
     budget = BUDGETS[args.budget]
-    experiments = args.only or list(EXPERIMENTS)
+    experiments = args.only or [e for e in EXPERIMENTS if not e.on_demand]
     start = time.perf_counter()
     try:
         units = plan(experiments, budget, args.out, args.seeds)

@@ -36,7 +36,7 @@ def plot_experiment(experiment, stats, runs, budget, path):
     budget : Budget
     path : path-like
     """
-    draw = {"fqi": _curves, "rmse": _bars, "dqn": _dqn, "attention": _attention}
+    draw = {"fqi": _curves, "rmse": _bars, "dqn": _dqn, "sb3": _dqn, "attention": _attention}
     fig = draw[experiment.kind](experiment, stats, runs, budget)
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)

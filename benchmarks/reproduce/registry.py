@@ -40,7 +40,7 @@ class Experiment:
     figure : str
         The thesis's figure ("3.6", "A.1"), or "extra".
     title : str
-    kind : {"fqi", "rmse", "dqn", "attention"}
+    kind : {"fqi", "rmse", "dqn", "sb3", "attention"}
         Default unit kind of the settings (a setting may set its own ``kind``).
     settings : dict of str to dict
         Label -> parameters (merged over `defaults`), in plotting order.
@@ -53,6 +53,11 @@ class Experiment:
     findings : tuple of rules
     notes : str
         Choices where the thesis is silent, for the report.
+    seeds : int, default=None
+        Runs per setting, instead of the budget's.
+    on_demand : bool, default=False
+        Run only when named (``--only``), and reported once it has runs: the baselines'
+        hyperparameter searches.
     """
 
     name: str
@@ -66,6 +71,8 @@ class Experiment:
     thesis: dict = field(default_factory=dict)
     findings: tuple = ()
     notes: str = ""
+    seeds: int = None
+    on_demand: bool = False
 
     def params(self, label, budget=None):
         """Full parameters of a setting (defaults, env and kind filled in), with the
@@ -210,6 +217,89 @@ EXPERIMENTS = (
         settings={"bounded TW=4": {}},
         notes="Tests weighted by the number of training samples reaching their node; the "
               "top boxes per action over a reference world's local view."),
+)
+
+# The baselines' hyperparameter searches (on demand: ``--only search_dqn_grid`` ...): each
+# configuration for a quarter of one FQI run's environment steps (100,000 at the full
+# budget), 2 seeds, starting from rl-zoo3's tuned settings for small discrete tasks
+# (rl_zoo3/hyperparams/dqn.yml and ppo.yml: LunarLander-v2, CartPole-v1, Acrobot-v1,
+# MountainCar-v0), with the discount factor among the searched values: the evaluation
+# counts undiscounted reward over 50 steps, and FQI's 0.5 need not suit DQN or PPO.
+_ZOO_DQN = {  # LunarLander-v2 (also Acrobot-v1), one gradient step per 4 env steps
+    "learning_rate": 6.3e-4, "batch_size": 128, "buffer_size": 50_000, "learning_starts": 1000,
+    "target_update_interval": 250, "train_freq": 4, "gradient_steps": 1,
+    "exploration_fraction": 0.12, "exploration_final_eps": 0.1,
+    "policy_kwargs": {"net_arch": [256, 256]}}
+_ZOO_DQN_CARTPOLE = {
+    "learning_rate": 2.3e-3, "batch_size": 64, "buffer_size": 100_000, "learning_starts": 1000,
+    "target_update_interval": 10, "train_freq": 256, "gradient_steps": 128,
+    "exploration_fraction": 0.16, "exploration_final_eps": 0.04,
+    "policy_kwargs": {"net_arch": [256, 256]}}
+_ZOO_DQN_MOUNTAINCAR = {
+    "learning_rate": 4e-3, "batch_size": 128, "buffer_size": 10_000, "learning_starts": 1000,
+    "target_update_interval": 600, "train_freq": 16, "gradient_steps": 8,
+    "exploration_fraction": 0.2, "exploration_final_eps": 0.07,
+    "policy_kwargs": {"net_arch": [256, 256]}}
+_DQN_SEARCH = {
+    "LunarLander, gamma 0.5": {**_ZOO_DQN, "gamma": 0.5},
+    "LunarLander, gamma 0.9": {**_ZOO_DQN, "gamma": 0.9},
+    "LunarLander, gamma 0.99": {**_ZOO_DQN, "gamma": 0.99},
+    "LunarLander, gamma 0.9, lr 1e-4": {**_ZOO_DQN, "gamma": 0.9, "learning_rate": 1e-4},
+    "LunarLander, gamma 0.9, 64x64, eps 0.02": {
+        **_ZOO_DQN, "gamma": 0.9, "exploration_final_eps": 0.02,
+        "policy_kwargs": {"net_arch": [64, 64]}},
+    "CartPole, gamma 0.9": {**_ZOO_DQN_CARTPOLE, "gamma": 0.9},
+    "CartPole, gamma 0.99": {**_ZOO_DQN_CARTPOLE, "gamma": 0.99},
+    "MountainCar, gamma 0.9": {**_ZOO_DQN_MOUNTAINCAR, "gamma": 0.9},
+}
+_ZOO_PPO = {  # LunarLander-v2
+    "n_envs": 16, "n_steps": 1024, "batch_size": 64, "gae_lambda": 0.98, "n_epochs": 4,
+    "ent_coef": 0.01}
+_ZOO_PPO_CARTPOLE = {
+    "n_envs": 8, "n_steps": 32, "batch_size": 256, "gae_lambda": 0.8, "n_epochs": 20,
+    "ent_coef": 0.0, "learning_rate": 1e-3, "clip_range": 0.2}
+_PPO_SEARCH = {
+    "LunarLander, gamma 0.9": {**_ZOO_PPO, "gamma": 0.9},
+    "LunarLander, gamma 0.99": {**_ZOO_PPO, "gamma": 0.99},
+    "LunarLander, gamma 0.9, 8 envs x 256": {**_ZOO_PPO, "gamma": 0.9, "n_envs": 8,
+                                             "n_steps": 256},
+    "LunarLander, gamma 0.9, lr 1e-4": {**_ZOO_PPO, "gamma": 0.9, "learning_rate": 1e-4},
+    "CartPole, gamma 0.9": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9},
+    "CartPole, gamma 0.98": {**_ZOO_PPO_CARTPOLE, "gamma": 0.98},
+    "CartPole, gamma 0.9, 64 steps": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9, "n_steps": 64},
+    "CartPole, gamma 0.9, ent 0.01": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9, "ent_coef": 0.01},
+}
+
+
+def _search(name, title, algo, observation, configs, extra=None, **defaults):
+    """A baseline's hyperparameter search: one setting per configuration of `configs`
+    (label -> the algorithm's arguments), and the `extra` settings as they are."""
+    return Experiment(
+        name, "extra", title, "sb3", on_demand=True, seeds=2,
+        defaults={"algo": algo, "observation": observation, "step_scale": 0.25,
+                  "checkpoints": 4, **defaults},
+        settings={**{label: {"hyperparams": config} for label, config in configs.items()},
+                  **(extra or {})},
+        notes=f"{algo} with rl-zoo3-derived settings (named by the zoo env they start from), "
+              f"a quarter of an FQI run's environment steps, 2 seeds; scored like FQI on "
+              f"the reference worlds after training.")
+
+
+EXPERIMENTS += (
+    _search("search_dqn_grid", "Search: DQN on 10 x 10 grid counts", "DQN", "grid",
+            _DQN_SEARCH, n_bins=10),
+    _search("search_dqn_objects", "Search: DQN on the objects (fqi.SetEncoder)", "DQN",
+            "objects", {label: config for label, config in _DQN_SEARCH.items()
+                        if "64x64" not in label},
+            extra={"LunarLander, gamma 0.9, attention": {
+                "hyperparams": {**_ZOO_DQN, "gamma": 0.9}, "attention": True}},
+            max_objects=128, attention=False),
+    _search("search_ppo_objects", "Search: PPO on the objects (fqi.SetEncoder)", "PPO",
+            "objects", {label: config for label, config in _PPO_SEARCH.items()
+                        if "ent 0.01" not in label},
+            extra={"CartPole, gamma 0.9, attention": {
+                "hyperparams": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9}, "attention": True}},
+            max_objects=128, attention=False),
 )
 
 REGISTRY = {experiment.name: experiment for experiment in EXPERIMENTS}

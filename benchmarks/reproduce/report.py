@@ -48,6 +48,8 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
     sections, summary, rows = [], {}, []
     for experiment in EXPERIMENTS:
         stats, runs = gather(experiment, budget, out, seeds)
+        if experiment.on_demand and not stats:
+            continue
         planned = len(experiment.settings) * len(seeds_for(experiment, budget, seeds))
         done = sum(s.n_runs for s in stats.values())
         verdicts = [rule.check(stats) for rule in experiment.findings]

@@ -45,8 +45,10 @@ class Unit:
         """Rough run time in seconds on 2 free cores (measured at the quick budget), for
         the progress bar's ETA."""
         p = self.params
-        if p["kind"] == "dqn":
-            return 2.5e-3 * (budget.dqn_steps or budget.iterations * self.samples)
+        if p["kind"] in ("dqn", "sb3"):
+            objects = 4.0 if p.get("observation") == "objects" else 1.0
+            return (2.5e-3 * (budget.dqn_steps or budget.iterations * self.samples)
+                    * p.get("step_scale", 1.0) * objects)
         trees = (p["n_estimators"] / 15 * (p["n_tests"] / 300) ** 0.5
                  if p.get("model") == "box" else 3.0)
         if p["kind"] == "rmse":
@@ -60,12 +62,12 @@ class Unit:
 
 
 def seeds_for(experiment, budget, seeds=None):
-    """Seeds of an experiment: `seeds` if given (each once), else ``range(budget.seeds)``;
-    the RMSE study and the attention figure use one data set / forest (seed 0), as the
-    thesis."""
+    """Seeds of an experiment: `seeds` if given (each once), else ``range(experiment.seeds
+    or budget.seeds)``; the RMSE study and the attention figure use one data set / forest
+    (seed 0), as the thesis."""
     if seeds is not None:
         return list(dict.fromkeys(seeds))
-    n = 1 if experiment.kind in ("rmse", "attention") else budget.seeds
+    n = 1 if experiment.kind in ("rmse", "attention") else experiment.seeds or budget.seeds
     return list(range(n))
 
 

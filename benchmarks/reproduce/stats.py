@@ -16,7 +16,7 @@ class SettingStats:
     Attributes
     ----------
     label : str
-    kind : {"fqi", "rmse", "dqn", "attention"}
+    kind : {"fqi", "rmse", "dqn", "sb3", "attention"}
     n_runs : int
     score : float
         FQI: mean over runs of the mean reward (per 20,000 steps) of the last
@@ -88,7 +88,7 @@ def summarise(label, kind, runs):
         scores = folds.mean(axis=1)
         return SettingStats(label, kind, len(runs), float(scores.mean()), _sd(scores),
                             _se(folds), lower_is_better=True, seconds=seconds)
-    if kind == "dqn":
+    if kind in ("dqn", "sb3"):
         rewards = np.array([r["reward"] for r in runs])
         return SettingStats(label, kind, len(runs), float(rewards.mean()), _sd(rewards),
                             _se(rewards), best=float(rewards.max()), seconds=seconds)

@@ -1,5 +1,5 @@
-"""One unit of work per (setting, seed): an FQI run, an RMSE study, a DQN run, or the
-attention figure's forest. Each returns a JSON-ready dict."""
+"""One unit of work per (setting, seed): an FQI run, an RMSE study, a DQN run, a tuned
+stable-baselines3 run, or the attention figure's forest. Each returns a JSON-ready dict."""
 import dataclasses
 import time
 from functools import lru_cache
@@ -12,7 +12,8 @@ from threadpoolctl import threadpool_limits
 
 import envs
 from boxtrees import ObjectSets
-from fqi import FQI, RandomPolicy, evaluate, make_box_forest, make_grid_ridge, train_dqn
+from fqi import (FQI, GridObservation, RandomPolicy, evaluate, make_box_forest, make_grid_ridge,
+                 train_dqn)
 
 __all__ = ["run_unit", "make_agent", "GAMMA"]
 
@@ -42,7 +43,7 @@ def run_unit(params, budget, seed, samples):
         JSON-ready; always has ``seconds``.
     """
     start = time.perf_counter()
-    runner = {"fqi": _fqi, "rmse": _rmse, "dqn": _dqn, "attention": _attention}
+    runner = {"fqi": _fqi, "rmse": _rmse, "dqn": _dqn, "sb3": _sb3, "attention": _attention}
     # One BLAS thread: the forests bring their own threads, and on 2 shared cores the
     # ridge fit of the grid baseline ran 10x slower with OpenBLAS's 2 threads (measured).
     with threadpool_limits(1, user_api="blas"):
@@ -171,6 +172,84 @@ def _dqn(params, budget, seed, samples):
                        seed=seed)
     return {"reward": result.reward * budget.reward_scale, "total_timesteps": steps,
             "train_seconds": result.train_seconds, "eval_seconds": result.eval_seconds}
+
+
+def _sb3(params, budget, seed, samples):
+    """A stable-baselines3 ``DQN`` or ``PPO`` run, its reward on the reference worlds at
+    ``params["checkpoints"]`` evenly spaced points of training (the last at the end).
+
+    ``params``: ``algo`` ("DQN" or "PPO"), ``observation`` ("grid": `fqi.GridObservation`
+    counts with ``n_bins``; "objects": `envs.PaddedObjects` of ``max_objects`` rows through
+    `fqi.SetEncoder`, with ``attention``), ``hyperparams`` (the algorithm's keyword
+    arguments; ``n_envs`` training envs), ``step_scale`` (the share of one FQI run's
+    environment steps it gets).
+    """
+    import torch
+    from stable_baselines3 import DQN, PPO
+    from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.logger import Logger
+
+    from fqi import SetEncoder   # imports torch: only here
+
+    steps = round((budget.dqn_steps or budget.iterations * samples) * params["step_scale"])
+    hyperparams = dict(params["hyperparams"])
+    n_envs = hyperparams.pop("n_envs", 1)
+    if params["observation"] == "grid":
+        def wrap(env):
+            return GridObservation(env, n_bins=params["n_bins"])
+    else:
+        def wrap(env):
+            return envs.PaddedObjects(env, max_objects=params["max_objects"])
+        hyperparams["policy_kwargs"] = {
+            **hyperparams.get("policy_kwargs", {}), "features_extractor_class": SetEncoder,
+            "features_extractor_kwargs": {"attention": params["attention"]}}
+    train_env = make_vec_env(lambda: wrap(_make_env(params)), n_envs=n_envs, seed=seed)
+    model = {"DQN": DQN, "PPO": PPO}[params["algo"]](
+        "MlpPolicy", train_env, seed=seed, device="cpu", **hyperparams)
+    model.set_logger(Logger(None, []))  # SB3's default logger makes a folder per run
+    policy = _WrappedPolicy(model, wrap(_make_env(params)))
+    reference = _reference_seeds(_make_env(params), budget)
+    due = [round(steps * (k + 1) / params["checkpoints"]) for k in range(params["checkpoints"])]
+    curve, eval_seconds = [], [0.0]
+
+    def checkpoint(model_steps):
+        start = time.perf_counter()
+        total = evaluate(policy, params["env_id"], seeds=reference).total
+        curve.append([int(model_steps), total * budget.reward_scale])
+        eval_seconds[0] += time.perf_counter() - start
+
+    class Checkpoints(BaseCallback):
+        def _on_step(self):
+            if len(curve) < len(due) - 1 and self.num_timesteps >= due[len(curve)]:
+                checkpoint(self.num_timesteps)
+            return True
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)  # on 2 shared cores the default pool ran 12x slower (measured)
+    try:
+        start = time.perf_counter()
+        model.learn(total_timesteps=steps, callback=Checkpoints())
+        checkpoint(model.num_timesteps)
+        train_seconds = time.perf_counter() - start - eval_seconds[0]
+    finally:
+        torch.set_num_threads(threads)
+    train_env.close()
+    return {"reward": curve[-1][1], "curve": curve, "total_timesteps": int(model.num_timesteps),
+            "train_seconds": train_seconds, "eval_seconds": eval_seconds[0]}
+
+
+class _WrappedPolicy:
+    """A model trained on an observation wrapper's output, playing from object sets (the
+    wrapper's ``observation`` applied to each)."""
+
+    def __init__(self, model, wrapper):
+        self.model, self.wrapper = model, wrapper
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        sets = [observation[i] for i in range(len(observation))]
+        batch = np.stack([self.wrapper.observation(s) for s in sets])
+        return self.model.predict(batch, deterministic=deterministic)[0], None
 
 
 def _attention(params, budget, seed, samples):
