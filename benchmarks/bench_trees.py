@@ -91,7 +91,7 @@ def single_sample_latency(forest, n_calls=2000):
 
 
 _MEMORY_SCRIPT = """
-import resource, sys
+import sys
 import numpy as np
 from boxtrees import BoxExtraTreesRegressor
 from sklearn.ensemble import ExtraTreesRegressor
@@ -104,7 +104,8 @@ model = {"ours": lambda: BoxExtraTreesRegressor(2, n_jobs=1, random_state=0),
          "sklearn": lambda: ExtraTreesRegressor(2, n_jobs=1, random_state=0)}.get(sys.argv[1])
 if model is not None:
     model().fit(X, y)
-print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)   # KiB on Linux
+# the peak of this process image (getrusage's ru_maxrss would keep the parent's from fork)
+print(next(line.split()[1] for line in open("/proc/self/status") if line.startswith("VmHWM")))
 """
 
 
@@ -115,7 +116,7 @@ def dense_fit_memory():
     for who in ("data", "ours", "sklearn"):
         done = subprocess.run([sys.executable, "-c", _MEMORY_SCRIPT, who], check=True,
                               capture_output=True, text=True)
-        peaks[who] = int(done.stdout.split()[-1]) / 1024
+        peaks[who] = int(done.stdout.split()[-1]) / 1024   # VmHWM is in KiB
     return peaks
 
 
