@@ -61,9 +61,10 @@ def reference_worlds(n=400):
     return [REFERENCE_SEED_START + i for i in range(int(n))]
 
 
-def _check_int(name, value, low):
+def _check_int(name, value, low, type_error=ValueError):
+    """`value` as an int ``>= low``; a non-int (bools included) raises `type_error`."""
     if not isinstance(value, Integral) or isinstance(value, bool):
-        raise ValueError(f"{name} must be an int, got {value!r}")
+        raise type_error(f"{name} must be an int, got {value!r}")
     if value < low:
         raise ValueError(f"{name} must be >= {low}, got {value}")
     return int(value)

@@ -23,11 +23,11 @@ which the path touches the coin, or a swipe's square holds the enemy, plus the s
 targets of the root's route it can still collect, in order from where it stands, each
 weighed by ``discount ** steps`` until the episode ends.
 """
-from numbers import Integral, Real
+from numbers import Real
 
 import numpy as np
 
-from ._rules import _REWARD_MONEY, _REWARD_SWIPE_ONE, MONEY
+from ._rules import _REWARD_MONEY, _REWARD_SWIPE_ONE, MONEY, _check_int
 from .batched import BatchedObjectWorld
 from .object_world import ObjectWorldEnv
 
@@ -38,14 +38,6 @@ _ROUTE_RATE = 20.0  # reward per step that ranks partial routes of different val
 _ROUTE_SEED = 0  # seeds the keys that hash sets of visited targets (fixed: deterministic)
 _TIE_BREAK = 1e-3  # reward per unit of distance to the next target (far below any reward)
 _EPS = 1e-9  # keeps a leg that ends exactly at the contact distance from costing a step more
-
-
-def _check_int(name, value, low):
-    if not isinstance(value, Integral) or isinstance(value, bool):
-        raise TypeError(f"{name} must be an int, got {value!r}")
-    if value < low:
-        raise ValueError(f"{name} must be >= {low}, got {value}")
-    return int(value)
 
 
 def _coin_legs(px, py, cx, cy, radius):
@@ -310,9 +302,9 @@ class LookaheadPlanner:
     """
 
     def __init__(self, depth=5, width=16, route_width=50, discount=0.95):
-        self.depth = _check_int("depth", depth, 1)
-        self.width = _check_int("width", width, 1)
-        self.route_width = _check_int("route_width", route_width, 1)
+        self.depth = _check_int("depth", depth, 1, TypeError)
+        self.width = _check_int("width", width, 1, TypeError)
+        self.route_width = _check_int("route_width", route_width, 1, TypeError)
         if not isinstance(discount, Real) or isinstance(discount, bool):
             raise TypeError(f"discount must be a number, got {discount!r}")
         if not 0.0 < discount <= 1.0:
