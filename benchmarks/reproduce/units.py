@@ -208,8 +208,9 @@ def _sb3(params, budget, seed, samples):
     model = {"DQN": DQN, "PPO": PPO}[params["algo"]](
         "MlpPolicy", train_env, seed=seed, device="cpu", **hyperparams)
     model.set_logger(Logger(None, []))  # SB3's default logger makes a folder per run
-    policy = _WrappedPolicy(model, wrap(_make_env(params)))
-    reference = _reference_seeds(_make_env(params), budget)
+    eval_wrapper = wrap(_make_env(params))    # pads or counts the evaluation's observations
+    policy = _WrappedPolicy(model, eval_wrapper)
+    reference = _reference_seeds(eval_wrapper, budget)
     due = [round(steps * (k + 1) / params["checkpoints"]) for k in range(params["checkpoints"])]
     curve, eval_seconds = [], [0.0]
 
