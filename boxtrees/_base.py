@@ -1,5 +1,8 @@
 """What the box-test tree estimators share: parameters, growing trees, walking them, and the
 encoding of regression and classification targets."""
+import os
+import threading
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from math import ceil
 from numbers import Integral, Real
@@ -18,13 +21,32 @@ from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
 from ._tree import BoxTree
 
-# below this many samples, prediction runs in the calling thread
-_PARALLEL_PREDICT_MIN_SAMPLES = 2048
+# prediction splits a batch into chunks of at least this many samples, one per thread
+_PREDICT_CHUNK_MIN = 64
 # y bands of the training-object index: at most this many, this many for large boxes
 _MAX_BANDS = 32
 _DEFAULT_BANDS = 8
 # counts, ids and loop bounds of the Cython core are 32-bit
 _INT32_MAX = 2**31 - 1
+
+
+_POOLS = {}  # (process id, threads) -> the prediction threads
+_POOLS_LOCK = threading.Lock()
+
+
+def _thread_pool(n_threads):
+    """The process's pool of `n_threads` prediction threads, started on first use.
+
+    Predictions are called once per environment step on batches of a few hundred samples,
+    where starting threads (as a joblib ``Parallel`` call does) costs about as much as the
+    work; the kernels release the GIL, so long-lived threads share a batch at no such cost.
+    A forked child starts its own pool (threads do not survive a fork).
+    """
+    key = (os.getpid(), n_threads)
+    with _POOLS_LOCK:
+        if key not in _POOLS:
+            _POOLS[key] = ThreadPoolExecutor(n_threads, thread_name_prefix="boxtrees-predict")
+        return _POOLS[key]
 
 
 class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
@@ -86,25 +108,25 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         self._packed = PackedForest(trees, self.types_)
 
     def _traverse(self, X, kernel, out, n_jobs=None):
-        """Validate ``X`` and run a traversal kernel over its samples into ``out(n)``, in
-        parallel chunks when the batch is large."""
+        """Validate ``X`` and run a traversal kernel over its samples into ``out(n)``, split
+        over up to ``n_jobs`` threads in chunks of at least `_PREDICT_CHUNK_MIN` samples."""
         if "_packed" not in self.__dict__:  # cheap test first: predict is called per step
             check_is_fitted(self)
         sets, _ = self._validate_input(X, reset=False)
         n = len(sets)
         out = out(n)
-        # chunks of at least half the threshold each; joblib is not even asked for small batches
-        n_chunks = 1
-        if n >= _PARALLEL_PREDICT_MIN_SAMPLES:
-            n_chunks = min(effective_n_jobs(n_jobs), n // (_PARALLEL_PREDICT_MIN_SAMPLES // 2))
-        if n_chunks == 1:
+        n_chunks = n // _PREDICT_CHUNK_MIN
+        if n_chunks > 1:  # effective_n_jobs costs as much as predicting one sample
+            n_threads = effective_n_jobs(n_jobs)
+            n_chunks = min(n_threads, n_chunks)
+        if n_chunks <= 1:
             results = [kernel(self._packed, sets.data, sets.offsets, out)]
         else:
             edges = np.linspace(0, n, n_chunks + 1).astype(np.intp)
-            results = Parallel(n_jobs=n_chunks, require="sharedmem")(
-                delayed(kernel)(self._packed, sets.data, sets.offsets[a : b + 1], out[a:b])
-                for a, b in zip(edges[:-1], edges[1:])
-            )
+            results = list(_thread_pool(n_threads).map(
+                lambda a, b: kernel(self._packed, sets.data, sets.offsets[a : b + 1], out[a:b]),
+                edges[:-1], edges[1:],
+            ))
         for problem, row in results:
             if problem == RowProblem.BAD_OFFSETS:
                 raise ValueError("the offsets of X changed while it was being read")

@@ -1,5 +1,8 @@
 """Correctness of BoxExtraTreesRegressor on object sets: traversal, learning, determinism."""
+import os
 import pickle
+import signal
+import time
 
 import joblib
 import numpy as np
@@ -149,14 +152,41 @@ def test_same_seed_same_forest_whatever_n_jobs_and_after_pickling():
     assert not np.array_equal(other.predict(X_new), expected)
 
 
-def test_parallel_predict_equals_serial_predict():
+@pytest.mark.parametrize("n", [1, 63, 64, 128, 129, 400, 5000])
+@pytest.mark.parametrize("n_jobs", [2, 3, -1])
+def test_parallel_predict_equals_serial_predict(n, n_jobs):
+    # batches of a few hundred samples (one per env of a vector env) are split over threads too
     X, y = make_box_regression(500, random_state=0)
-    X_big, _ = make_box_regression(5000, random_state=1)
+    X_new, _ = make_box_regression(n, random_state=1)
     forest = BoxExtraTreesRegressor(n_estimators=4, n_tests=20, random_state=0).fit(X, y)
-    serial = forest.predict(X_big)
-    forest.set_params(n_jobs=2)
-    np.testing.assert_array_equal(forest.predict(X_big), serial)
-    np.testing.assert_array_equal(forest.apply(X_big), forest.set_params(n_jobs=1).apply(X_big))
+    serial, leaves = forest.predict(X_new), forest.apply(X_new)
+    forest.set_params(n_jobs=n_jobs)
+    np.testing.assert_array_equal(forest.predict(X_new), serial)
+    np.testing.assert_array_equal(forest.apply(X_new), leaves)
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
+def test_a_forked_child_predicts_on_threads_of_its_own():
+    X, y = make_box_regression(500, random_state=0)
+    forest = BoxExtraTreesRegressor(n_estimators=4, n_tests=20, n_jobs=2, random_state=0).fit(X, y)
+    expected = forest.predict(X)  # the parent's prediction threads exist before the fork
+    reader, writer = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: the parent's threads are gone; a hang here fails the wait below
+        os.close(reader)
+        ok = np.array_equal(forest.predict(X), expected)
+        os.write(writer, b"1" if ok else b"0")
+        os._exit(0)
+    os.close(writer)
+    deadline = time.monotonic() + 60
+    while os.waitpid(pid, os.WNOHANG) == (0, 0):
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            pytest.fail("the forked child hung predicting on its parent's threads")
+        time.sleep(0.05)
+    assert os.read(reader, 1) == b"1"
+    os.close(reader)
 
 
 def test_dask_backend_builds_the_same_forest():
