@@ -19,8 +19,8 @@ from benchmarks.reproduce import plots, runner
 from benchmarks.reproduce.cache import (attempts, load_unit, mark_attempt, save_unit, slug,
                                         unit_path)
 from benchmarks.reproduce.cli import main, parse_seeds
-from benchmarks.reproduce.findings import (Falls, HighestPeak, MoreStable, NearRandom,
-                                           Ranking, Sign, Similar)
+from benchmarks.reproduce.findings import (AtLeast, Falls, Faster, HighestPeak, MoreStable,
+                                           NearRandom, Ranking, Sign, Similar)
 from benchmarks.reproduce.registry import Experiment, resolve
 from benchmarks.reproduce.report import figure_name, write_outputs
 from benchmarks.reproduce.runner import MAX_ATTEMPTS, ClusterError, cluster, gather, plan, run
@@ -36,8 +36,8 @@ def test_registry_covers_every_thesis_figure_once():
     assert sorted(figures) == sorted(["A.1", "A.2", "A.3", "A.4", "A.5", "3.1", "3.2", "3.3",
                                       "3.4", "3.5", "3.6", "3.8", "3.9", "3.10"])
     assert {e.name for e in EXPERIMENTS if e.figure == "extra"} == {
-        "keep_data", "dqn", "attention", "search_dqn_grid", "search_dqn_objects",
-        "search_ppo_objects"}
+        "keep_data", "dqn", "attention", "ceiling", "ceiling_sword", "baselines",
+        "search_dqn_grid", "search_dqn_objects", "search_ppo_objects"}
     assert {e.name for e in EXPERIMENTS if e.on_demand} == {
         "search_dqn_grid", "search_dqn_objects", "search_ppo_objects"}
     assert len(REGISTRY) == len(EXPERIMENTS)
@@ -55,7 +55,7 @@ def _rule_labels(rule):
 
 @pytest.mark.parametrize("experiment", EXPERIMENTS, ids=lambda e: e.name)
 def test_every_setting_resolves_and_every_rule_names_real_settings(experiment):
-    kinds = {"fqi", "rmse", "dqn", "sb3", "attention"}
+    kinds = {"fqi", "rmse", "dqn", "sb3", "policy", "attention"}
     assert experiment.kind in kinds
     for label in experiment.settings:
         owner, owner_label = resolve(experiment, label)
@@ -65,10 +65,13 @@ def test_every_setting_resolves_and_every_rule_names_real_settings(experiment):
         if params["kind"] == "sb3":
             assert {"algo", "observation", "hyperparams", "step_scale"} <= set(params)
             assert "gamma" in params["hyperparams"]      # searched, never SB3's default
+        elif params["kind"] == "policy":
+            assert params["policy"] in ("planner", "greedy", "random")
         elif params.get("model", "box") == "box" and params["kind"] != "dqn":
             assert {"test_type", "n_estimators", "n_tests", "min_samples_split"} <= set(params)
     for rule in experiment.findings:
         assert set(_rule_labels(rule)) <= set(experiment.settings), rule
+    assert experiment.ceiling is None or experiment.ceiling in experiment.settings
 
 
 def test_thesis_axes_and_budgets():
@@ -430,6 +433,13 @@ def test_other_rules():
                                           ).holds is True
     assert HighestPeak("a", ("a", "b"), "").check(stats).holds is True
     assert Falls(("b", "a"), "").check(stats).holds is True
+    timed = {"a": _stats("a", 100, seconds=50.0), "b": _stats("b", 0, seconds=100.0)}
+    assert Faster("a", ("b",), 0.5, "").check(timed).holds is True
+    assert Faster("a", ("b",), 0.4, "").check(timed).holds is False
+    assert "a 0.8, b 1.7" in Faster("a", ("b",), 0.5, "").check(timed).explanation
+    assert AtLeast(("a", "b"), 100, "").check(stats).holds is True   # the best of them
+    assert AtLeast(("a", "b"), 101, "").check(stats).holds is False
+    assert AtLeast(("a", "b"), 1, "").check({"b": b}).holds is None  # not run: a
 
 
 def test_summarise_fqi_runs():
@@ -674,3 +684,43 @@ def test_a_ppo_run_on_the_objects_with_attention():
     result = run_unit(params, TINY, 0, TINY.samples)
     assert params["attention"] and result["total_timesteps"] >= TINY.dqn_steps
     assert len(result["curve"]) == 4 and np.isfinite(result["reward"])
+
+
+def test_reference_policies_score_on_the_reference_worlds_as_learners_do():
+    from fqi import evaluate
+    from benchmarks.reproduce.units import run_unit
+
+    budget = replace(TINY, eval_steps=150)  # 3 reference worlds
+    seeds = envs.reference_worlds(3)
+    worlds = envs.BatchedObjectWorld(3)
+    greedy = run_unit({"kind": "policy", "env_id": "ObjectWorld-v0", "policy": "greedy"},
+                      budget, 0, TINY.samples)
+    direct = evaluate(envs.GreedyPolicy(worlds), worlds, seeds=seeds)
+    assert greedy["episode_returns"] == direct.returns.tolist()
+    assert greedy["reward"] == direct.total * budget.reward_scale
+    planner = run_unit({"kind": "policy", "env_id": "ObjectWorld-v0", "policy": "planner",
+                        "depth": 2, "width": 2}, budget, 0, TINY.samples)
+    rewards = [envs.LookaheadPlanner(depth=2, width=2).play(envs.ObjectWorldEnv(), seed=s)[1]
+               for s in seeds]
+    assert planner["episode_returns"] == [float(r.sum()) for r in rewards]
+    assert planner["player"] == "LookaheadPlanner(depth=2, width=2, route_width=50, discount=0.95)"
+
+
+def test_baselines_share_their_owners_runs_and_read_against_the_ceiling(tiny_run):
+    out, _ = tiny_run
+    baselines = REGISTRY["baselines"]
+    owners = {resolve(baselines, label)[0].name for label in baselines.settings}
+    assert owners == {"representations", "keep_data", "baselines", "ceiling"}
+    # one run of each reference policy, the budget's seeds for the rest
+    assert len(runner.seeds_for(REGISTRY["ceiling"], BUDGETS["full"])) == 1
+    stats, runs = gather(baselines, TINY, out)
+    assert set(stats) == set(baselines.settings)
+    section = (out / "REPORT.md").read_text().split('<a id="baselines"></a>')[1]
+    ceiling = stats["look-ahead planner"].score
+    for label, s in stats.items():
+        assert f"| {label} | {s.n_runs} | {s.score:,.0f} +- {s.score_sd:,.0f} | " \
+               f"{s.score / ceiling:.0%} |" in section
+    fqi_run = runs["box FQI, fixed TW=1"][0]
+    assert fqi_run["result"]["rewards"] == json.loads(unit_path(
+        out, TINY, "representations", "fixed TW=1", 0).read_text())["result"]["rewards"]
+    assert (out / "extra_baselines.png").stat().st_size > 0

@@ -50,6 +50,7 @@ _BUDGET_FIELDS = {
     "rmse": ("rmse_samples", "rmse_folds", "max_trees", "max_tests"),
     "dqn": ("iterations", "eval_steps", "dqn_steps"),
     "sb3": ("iterations", "eval_steps", "dqn_steps"),
+    "policy": ("eval_steps",),
     "attention": ("attention_iterations", "eval_steps", "max_trees", "max_tests"),
 }
 
@@ -78,6 +79,7 @@ def _record_shape(kind, budget):
         "rmse": {"fold_rmse": _ListOf(float, budget.rmse_folds)},
         "dqn": {"reward": float},
         "sb3": {"reward": float, "curve": _ListOf(_ListOf(float, 2))},
+        "policy": {"reward": float},
         "attention": {"world_seed": int, "reward": float, "q_values": _ListOf(float),
                       "actions": _ListOf({"tests": _ListOf(_ListOf(float, 9)),
                                           "type_usage": _ListOf(float)})},

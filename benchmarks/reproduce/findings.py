@@ -8,7 +8,7 @@ import math
 from dataclasses import dataclass
 
 __all__ = ["Verdict", "Ranking", "Similar", "MoreStable", "Sign", "NearRandom",
-           "HighestPeak", "Falls"]
+           "HighestPeak", "Falls", "Faster", "AtLeast"]
 
 # Two scores closer than this many combined standard errors are "within noise".
 _NOISE_SE = 2.0
@@ -212,3 +212,36 @@ class Falls(_Rule):
         listed = ", ".join(f"{label} {_fmt(stats[label].score)}" for label in self.labels)
         return Verdict(self.claim, _better(last, first),
                        f"measured {listed}{_gap_note(first, last)}")
+
+
+@dataclass(frozen=True)
+class Faster(_Rule):
+    """`label` takes at most `ratio` times the mean wall time per run of each of `others`."""
+
+    label: str
+    others: tuple
+    ratio: float
+    claim: str
+
+    def _needs(self):
+        return (self.label, *self.others)
+
+    def _judge(self, stats):
+        mine = stats[self.label].seconds
+        listed = ", ".join(f"{label} {stats[label].seconds / 60:.1f}" for label in self._needs())
+        holds = all(mine <= self.ratio * stats[o].seconds for o in self.others)
+        return Verdict(self.claim, holds, f"minutes per run: {listed}")
+
+
+@dataclass(frozen=True)
+class AtLeast(_Rule):
+    """The best score among `labels` reaches `value`."""
+
+    labels: tuple
+    value: float
+    claim: str
+
+    def _judge(self, stats):
+        best = max(self.labels, key=lambda label: stats[label].score)
+        return Verdict(self.claim, stats[best].score >= self.value,
+                       f"best: {best} {_fmt(stats[best].score)} (goal {_fmt(self.value)})")

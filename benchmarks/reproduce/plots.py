@@ -1,5 +1,6 @@
 """Figures in the thesis's form: reward curves with a std band, RMSE bars, the DQN
-comparison, and the attention figure (most used test boxes over a local view)."""
+comparison, reward against environment steps for every method, and the attention figure
+(most used test boxes over a local view)."""
 import matplotlib
 
 matplotlib.use("Agg")
@@ -7,7 +8,7 @@ import gymnasium as gym  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
-from matplotlib.ticker import MaxNLocator  # noqa: E402
+from matplotlib.ticker import MaxNLocator, StrMethodFormatter  # noqa: E402
 
 import envs  # noqa: E402
 
@@ -21,6 +22,8 @@ _TYPE_COLOURS = {kind: tuple(c / 255 for c in rgb) for kind, rgb in envs.TYPE_CO
 # envs' names, as labels ("money marker", "swipe up")
 TYPE_NAMES = tuple(name.replace("_", " ") for name in envs.TYPE_NAMES)
 ACTION_NAMES = tuple(name.replace("_", " ") for name in envs.ACTION_NAMES)
+# reference policies' lines, best first (a planner, a heuristic, random play)
+_REFERENCE_COLOURS = ("black", "dimgrey", "darkgrey", "silver")
 
 
 def plot_experiment(experiment, stats, runs, budget, path):
@@ -36,8 +39,9 @@ def plot_experiment(experiment, stats, runs, budget, path):
     budget : Budget
     path : path-like
     """
-    draw = {"fqi": _curves, "rmse": _bars, "dqn": _dqn, "sb3": _dqn, "attention": _attention}
-    fig = draw[experiment.kind](experiment, stats, runs, budget)
+    draw = {"fqi": _curves, "rmse": _bars, "dqn": _dqn, "sb3": _dqn, "policy": _dqn,
+            "attention": _attention, "steps": _versus_steps}
+    fig = draw[experiment.plot or experiment.kind](experiment, stats, runs, budget)
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
@@ -105,6 +109,42 @@ def _dqn(experiment, stats, runs, budget):
     ax.set_ylabel("reward per 20,000 greedy steps")
     ax.set_title(_title(experiment, budget, stats), fontsize=10)
     ax.grid(axis="y", alpha=0.3)
+    return fig
+
+
+def _versus_steps(experiment, stats, runs, budget):
+    """Reward against environment steps, mean +- 1 sd over runs: FQI after each iteration
+    (its samples per iteration apart, the random policy at 0), the baselines at their
+    checkpoints; reference policies as horizontal lines."""
+    fig, ax = plt.subplots(figsize=(7.5, 4.5))
+    drawn = []
+    for label, s in stats.items():
+        if s.kind == "policy":
+            colour = _REFERENCE_COLOURS[sum(t.kind == "policy" for t in drawn)]
+            drawn.append(s)
+            ax.axhline(s.score, ls="--", lw=1.0, color=colour)
+            ax.annotate(f"{label} ({s.score:,.0f})", (0, s.score), xytext=(2, 3),
+                        textcoords="offset points", fontsize=7, color=colour)
+            continue
+        if s.kind == "fqi":
+            x = np.arange(len(s.curve_mean)) * runs[label][0]["budget"]["samples"]
+            mean, sd = s.curve_mean, s.curve_sd
+        else:
+            curves = np.array([r["result"]["curve"] for r in runs[label]], dtype=float)
+            x, rewards = curves[0, :, 0], curves[:, :, 1]
+            mean, sd = rewards.mean(axis=0), rewards.std(axis=0)
+        ax.plot(x, mean, marker="o", markersize=3, label=f"{label} ({s.score:,.0f}, "
+                f"{s.seconds / 60:.0f} min/run)")
+        ax.fill_between(x, mean - sd, mean + sd, alpha=0.2)
+    ax.axhline(0, color="grey", lw=0.6)
+    ax.set_xlabel("environment steps")
+    ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
+    ax.yaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
+    ax.set_ylabel("reward per 20,000 greedy steps")
+    ax.set_title(_title(experiment, budget, stats), fontsize=10)
+    ax.legend(fontsize=7, loc="lower right", title="method (final score, wall time)",
+              title_fontsize=7)
+    ax.grid(alpha=0.3)
     return fig
 
 

@@ -6,7 +6,7 @@ import time
 from pathlib import Path
 
 from .plots import ACTION_NAMES, TYPE_NAMES, plot_experiment
-from .registry import EXPERIMENTS
+from .registry import EXPERIMENTS, resolve
 from .runner import gather, seeds_for
 from .stats import LAST_WINDOW
 
@@ -50,7 +50,8 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
         stats, runs = gather(experiment, budget, out, seeds)
         if experiment.on_demand and not stats:
             continue
-        planned = len(experiment.settings) * len(seeds_for(experiment, budget, seeds))
+        planned = sum(len(seeds_for(resolve(experiment, label)[0], budget, seeds))
+                      for label in experiment.settings)
         done = sum(s.n_runs for s in stats.values())
         verdicts = [rule.check(stats) for rule in experiment.findings]
         if stats:
@@ -134,7 +135,8 @@ def _section(experiment, stats, runs, verdicts, done, planned):
               f"![{experiment.name}]({figure_name(experiment)})", ""]
     lines += _table(experiment, stats, runs)
     if verdicts:
-        lines += ["", "Thesis findings, checked on these numbers:", ""]
+        whose = "Claims" if experiment.figure == "extra" else "Thesis findings"
+        lines += ["", f"{whose}, checked on these numbers:", ""]
         lines += [f"- {v.claim}: **{v.mark}**. {v.explanation}" for v in verdicts]
     if experiment.notes:
         lines += ["", f"Notes: {experiment.notes}"]
@@ -154,17 +156,20 @@ def _table(experiment, stats, runs):
             sd = (sum((f - s.score) ** 2 for f in folds) / max(len(folds) - 1, 1)) ** 0.5
             lines.append(f"| {label} | {s.score:.2f} | {sd:.2f} | {thesis.get(label, '')} |")
         return lines
-    lines = ["| setting | runs | score +- sd over runs | best evaluation | mean abs. change "
-             "between iterations | minutes per run | thesis |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
+    ceiling = stats.get(experiment.ceiling)
+    share = "" if ceiling is None else f" share of the {experiment.ceiling}'s |"
+    lines = ["| setting | runs | score +- sd over runs |" + share + " best evaluation | "
+             "mean abs. change between iterations | minutes per run | thesis |",
+             "| --- " * (7 + bool(share)) + "|"]
     for label, s in stats.items():
-        lines.append(f"| {label} | {s.n_runs} | {_fmt(s.score)} +- {_fmt(s.score_sd)} | "
+        part = "" if ceiling is None else f" {s.score / ceiling.score:.0%} |"
+        lines.append(f"| {label} | {s.n_runs} | {_fmt(s.score)} +- {_fmt(s.score_sd)} |{part} "
                      f"{_fmt(s.best)} | {_fmt(s.instability)} | {s.seconds / 60:.1f} | "
                      f"{thesis.get(label, '')} |")
     randoms = [s.random_reward for s in stats.values() if not math.isnan(s.random_reward)]
     if randoms:
-        lines.append(f"| random policy | | {_fmt(sum(randoms) / len(randoms))} | | | | "
-                     f"{thesis.get('random policy', '')} |")
+        lines.append(f"| random policy | | {_fmt(sum(randoms) / len(randoms))} |"
+                     + " |" * bool(share) + f" | | | {thesis.get('random policy', '')} |")
     return lines
 
 

@@ -45,6 +45,8 @@ class Unit:
         """Rough run time in seconds on 2 free cores (measured at the quick budget), for
         the progress bar's ETA."""
         p = self.params
+        if p["kind"] == "policy":  # the planner: about a minute on the 4-action game
+            return 60.0 * budget.eval_steps / 20_000 if p["policy"] == "planner" else 1.0
         if p["kind"] in ("dqn", "sb3"):
             objects = 4.0 if p.get("observation") == "objects" else 1.0
             return (2.5e-3 * (budget.dqn_steps or budget.iterations * self.samples)
@@ -64,10 +66,13 @@ class Unit:
 def seeds_for(experiment, budget, seeds=None):
     """Seeds of an experiment: `seeds` if given (each once), else ``range(experiment.seeds
     or budget.seeds)``; the RMSE study and the attention figure use one data set / forest
-    (seed 0), as the thesis."""
+    (seed 0), as the thesis, and a reference policy's score needs one run.
+
+    A ``same_as`` setting runs with the seeds of the experiment owning it."""
     if seeds is not None:
         return list(dict.fromkeys(seeds))
-    n = 1 if experiment.kind in ("rmse", "attention") else experiment.seeds or budget.seeds
+    one = experiment.kind in ("rmse", "attention", "policy")
+    n = 1 if one else experiment.seeds or budget.seeds
     return list(range(n))
 
 
@@ -92,7 +97,7 @@ def plan(experiments, budget, out, seeds=None):
         for label in experiment.settings:
             owner, owner_label = resolve(experiment, label)
             samples = int(budget.samples * owner.sample_scale)
-            for seed in seeds_for(experiment, budget, seeds):
+            for seed in seeds_for(owner, budget, seeds):
                 path = unit_path(out, budget, owner.name, owner_label, seed)
                 units.setdefault(path, Unit(owner.name, owner_label, seed,
                                             owner.params(owner_label, budget), samples, path))
@@ -434,7 +439,7 @@ def gather(experiment, budget, out, seeds=None):
         samples = int(budget.samples * owner.sample_scale)
         records = [load_unit(unit_path(out, budget, owner.name, owner_label, seed), params,
                              budget, samples, seed)
-                   for seed in seeds_for(experiment, budget, seeds)]
+                   for seed in seeds_for(owner, budget, seeds)]
         records = [r for r in records if r is not None]
         if records:
             runs[label] = records

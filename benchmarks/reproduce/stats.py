@@ -16,11 +16,12 @@ class SettingStats:
     Attributes
     ----------
     label : str
-    kind : {"fqi", "rmse", "dqn", "sb3", "attention"}
+    kind : {"fqi", "rmse", "dqn", "sb3", "policy", "attention"}
     n_runs : int
     score : float
         FQI: mean over runs of the mean reward (per 20,000 steps) of the last
-        `LAST_WINDOW` iterations; DQN: mean final reward; RMSE: mean RMSE.
+        `LAST_WINDOW` iterations; DQN, SB3, a reference policy: mean final reward; RMSE:
+        mean RMSE.
     score_sd : float
         Standard deviation of the per-run scores (0 with one run).
     score_se : float
@@ -88,7 +89,7 @@ def summarise(label, kind, runs):
         scores = folds.mean(axis=1)
         return SettingStats(label, kind, len(runs), float(scores.mean()), _sd(scores),
                             _se(folds), lower_is_better=True, seconds=seconds)
-    if kind in ("dqn", "sb3"):
+    if kind in ("dqn", "sb3", "policy"):
         rewards = np.array([r["reward"] for r in runs])
         return SettingStats(label, kind, len(runs), float(rewards.mean()), _sd(rewards),
                             _se(rewards), best=float(rewards.max()), seconds=seconds)

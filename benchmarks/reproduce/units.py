@@ -1,5 +1,6 @@
 """One unit of work per (setting, seed): an FQI run, an RMSE study, a DQN run, a tuned
-stable-baselines3 run, or the attention figure's forest. Each returns a JSON-ready dict."""
+stable-baselines3 run, a reference policy's score (the planner's ceiling, the scripted
+heuristic, random play), or the attention figure's forest. Each returns a JSON-ready dict."""
 import dataclasses
 import time
 from functools import lru_cache
@@ -43,7 +44,8 @@ def run_unit(params, budget, seed, samples):
         JSON-ready; always has ``seconds``.
     """
     start = time.perf_counter()
-    runner = {"fqi": _fqi, "rmse": _rmse, "dqn": _dqn, "sb3": _sb3, "attention": _attention}
+    runner = {"fqi": _fqi, "rmse": _rmse, "dqn": _dqn, "sb3": _sb3, "policy": _policy,
+              "attention": _attention}
     # One BLAS thread: the forests bring their own threads, and on 2 shared cores the
     # ridge fit of the grid baseline ran 10x slower with OpenBLAS's 2 threads (measured).
     with threadpool_limits(1, user_api="blas"):
@@ -238,6 +240,38 @@ def _sb3(params, budget, seed, samples):
     train_env.close()
     return {"reward": curve[-1][1], "curve": curve, "total_timesteps": int(model.num_timesteps),
             "train_seconds": train_seconds, "eval_seconds": eval_seconds[0]}
+
+
+def _policy(params, budget, seed, samples):
+    """The score of a reference policy that does not learn, on the reference worlds:
+    ``params["policy"]`` is "planner" (`envs.LookaheadPlanner` with ``depth`` and ``width``:
+    the ceiling, it plays with the simulator), "greedy" (`envs.GreedyPolicy`, scripted) or
+    "random" (uniform, action seed `seed`). Played through `fqi.evaluate`, as the learners."""
+    reference = _reference_seeds(_make_env(params), budget)
+    worlds = gym.make_vec(params["env_id"], num_envs=len(reference))
+    if params["policy"] == "planner":
+        planner = envs.LookaheadPlanner(depth=params["depth"], width=params["width"])
+        policy = _PlannerPolicy(planner, worlds)
+    elif params["policy"] == "greedy":
+        policy = envs.GreedyPolicy(worlds)
+    else:
+        policy = RandomPolicy(worlds, seed=seed)
+    result = evaluate(policy, worlds, seeds=reference)
+    worlds.close()
+    player = repr(planner) if params["policy"] == "planner" else type(policy).__name__
+    return {"reward": result.total * budget.reward_scale, "player": player,
+            "episode_returns": result.returns.tolist()}
+
+
+class _PlannerPolicy:
+    """`envs.LookaheadPlanner` behind ``predict``: it plans from the state of `worlds`
+    (the vector env being evaluated), not from the observations."""
+
+    def __init__(self, planner, worlds):
+        self.planner, self.worlds = planner, worlds
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        return self.planner.act(self.worlds), None
 
 
 class _WrappedPolicy:
