@@ -35,9 +35,15 @@ def test_registry_covers_every_thesis_figure_once():
     figures = [e.figure for e in EXPERIMENTS if e.figure != "extra"]
     assert sorted(figures) == sorted(["A.1", "A.2", "A.3", "A.4", "A.5", "3.1", "3.2", "3.3",
                                       "3.4", "3.5", "3.6", "3.8", "3.9", "3.10"])
-    assert {e.name for e in EXPERIMENTS if e.figure == "extra"} == {
+    assert {e.name for e in EXPERIMENTS if e.figure == "extra" and not e.explains} == {
         "keep_data", "dqn", "attention", "ceiling", "ceiling_sword", "baselines",
         "search_dqn_grid", "search_dqn_objects", "search_ppo_objects"}
+    ablations = [e for e in EXPERIMENTS if e.explains]
+    assert {name for e in ablations for name in e.explains} == {
+        "rmse_K", "rmse_nmin", "rmse_TW", "rmse_grid", "fqi_grid", "representations"}
+    for ablation in ablations:
+        assert ablation.figure == "extra" and ablation.hypothesis and ablation.findings
+        assert all(REGISTRY[name].figure != "extra" for name in ablation.explains)
     assert {e.name for e in EXPERIMENTS if e.on_demand} == {
         "search_dqn_grid", "search_dqn_objects", "search_ppo_objects"}
     assert len(REGISTRY) == len(EXPERIMENTS)
@@ -724,3 +730,31 @@ def test_baselines_share_their_owners_runs_and_read_against_the_ceiling(tiny_run
     assert fqi_run["result"]["rewards"] == json.loads(unit_path(
         out, TINY, "representations", "fixed TW=1", 0).read_text())["result"]["rewards"]
     assert (out / "extra_baselines.png").stat().st_size > 0
+
+
+def test_an_ablations_game_constants_and_ridge_penalty_reach_its_units():
+    from benchmarks.reproduce.units import _make_env, _regressor
+
+    params = REGISTRY["rmse_TW_reach"].params("TW=2.5, reach 2")
+    rules = _make_env(params).unwrapped.rules
+    assert (rules.contact_radius, rules.start_clearance) == (2.0, 2.0)
+    assert _make_env(REGISTRY["rmse_TW"].params("TW=2.5")).unwrapped.rules.contact_radius == 0.6
+    grid = REGISTRY["fqi_grid_alpha"].params("N=15, alpha=1000")
+    ridge = _regressor(grid, _make_env(grid), TINY, 0)
+    assert ridge[0].n_bins == 15 and ridge[-1].alpha == 1000.0
+    assert _regressor(REGISTRY["fqi_grid"].params("N=15"), _make_env(grid), TINY, 0)[-1].alpha == 1.0
+
+
+def test_each_ablation_is_reported_under_why_it_differs_in_the_sections_it_explains(tiny_run):
+    out, _ = tiny_run
+    text = (out / "REPORT.md").read_text()
+    sections = dict(re.findall(r'<a id="(\w+)"></a>\n(.*?)(?=<a id=|\Z)', text, re.S))
+    summary = json.loads((out / "summary.json").read_text())["experiments"]
+    for ablation in (e for e in EXPERIMENTS if e.explains):
+        for name in ablation.explains:
+            why = sections[name].split("### Why it differs", 1)[1]
+            assert f"([{ablation.name}](#{ablation.name})," in why
+            assert ablation.hypothesis in why
+            for finding in summary[ablation.name]["findings"]:   # the computed verdicts
+                mark = {True: "yes", False: "no"}.get(finding["holds"], "n/a")
+                assert f"- {finding['claim']}: **{mark}**. {finding['explanation']}" in why

@@ -6,7 +6,7 @@ import time
 from pathlib import Path
 
 from .plots import ACTION_NAMES, TYPE_NAMES, plot_experiment
-from .registry import EXPERIMENTS, resolve
+from .registry import EXPERIMENTS, REGISTRY, resolve
 from .runner import gather, seeds_for
 from .stats import LAST_WINDOW
 
@@ -45,7 +45,7 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    sections, summary, rows = [], {}, []
+    sections, summary, rows, measured = [], {}, [], {}
     for experiment in EXPERIMENTS:
         stats, runs = gather(experiment, budget, out, seeds)
         if experiment.on_demand and not stats:
@@ -53,12 +53,18 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
         planned = sum(len(seeds_for(resolve(experiment, label)[0], budget, seeds))
                       for label in experiment.settings)
         done = sum(s.n_runs for s in stats.values())
-        verdicts = [rule.check(stats) for rule in experiment.findings]
+        measured[experiment.name] = (stats, runs, [rule.check(stats) for rule in
+                                                   experiment.findings], done, planned)
+    for name, (stats, runs, verdicts, done, planned) in measured.items():
+        experiment = REGISTRY[name]
         if stats:
             plot_experiment(experiment, stats, runs, budget, out / figure_name(experiment))
             _write_csv(experiment, runs, out / f"{experiment.name}.csv")
         summary[experiment.name] = _summary_entry(experiment, stats, verdicts, done, planned)
-        sections.append(_section(experiment, stats, runs, verdicts, done, planned))
+        ablations = [(REGISTRY[other], measured[other]) for other in measured
+                     if name in REGISTRY[other].explains]
+        sections.append(_section(experiment, stats, runs, verdicts, done, planned)
+                        + _why_it_differs(ablations))
         rows.extend((experiment, v, done, planned) for v in verdicts)
         if not experiment.findings:
             rows.append((experiment, None, done, planned))
@@ -141,6 +147,26 @@ def _section(experiment, stats, runs, verdicts, done, planned):
     if experiment.notes:
         lines += ["", f"Notes: {experiment.notes}"]
     return "\n".join(lines + [""])
+
+
+def _why_it_differs(ablations):
+    """The "Why it differs" part of a section: each ablation's hypothesis, and the thesis's
+    claim re-checked under it."""
+    if not ablations:
+        return ""
+    lines = ["", "### Why it differs", ""]
+    for ablation, (stats, _, verdicts, done, planned) in ablations:
+        lines += [f"**Hypothesis** ([{ablation.name}](#{ablation.name}), {done}/{planned} "
+                  f"runs): {ablation.hypothesis}", ""]
+        if not stats:
+            lines += ["Not run at this budget yet.", ""]
+            continue
+        lines += [f"- {v.claim}: **{v.mark}**. {v.explanation}" for v in verdicts]
+        recovered = [v.claim for v in verdicts if v.holds]
+        lines += ["", "Shown: " + (f"recovered in this ablation: {'; '.join(recovered)}."
+                                   if recovered else "the thesis's finding is not recovered "
+                                   "in this ablation either."), ""]
+    return "\n".join(lines)
 
 
 def _table(experiment, stats, runs):

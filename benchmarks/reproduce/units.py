@@ -54,9 +54,14 @@ def run_unit(params, budget, seed, samples):
     return result
 
 
+def _env_kwargs(params):
+    """The game's arguments a setting changes: its ``view`` and its ``rules`` (constants of
+    `envs.WorldRules`, for the ablations)."""
+    return {**({"view": params["view"]} if "view" in params else {}), **params.get("rules", {})}
+
+
 def _make_env(params):
-    kwargs = {"view": params["view"]} if "view" in params else {}
-    return gym.make(params["env_id"], **kwargs)
+    return gym.make(params["env_id"], **_env_kwargs(params))
 
 
 def _reference_seeds(env, budget):
@@ -68,7 +73,7 @@ def _reference_seeds(env, budget):
 def _regressor(params, env, budget, seed):
     """The setting's regressor, with the budget's caps on M and K."""
     if params["model"] == "grid":
-        return make_grid_ridge(env, n_bins=params["n_bins"])
+        return make_grid_ridge(env, n_bins=params["n_bins"], alpha=params.get("alpha", 1.0))
     return make_box_forest(
         env, test_type=params["test_type"], test_width=params.get("test_width", 1.0),
         n_estimators=_capped(params["n_estimators"], budget.max_trees),
@@ -122,10 +127,10 @@ def _fqi(params, budget, seed, samples):
 
 
 @lru_cache(maxsize=4)
-def _random_transitions(env_id, view, n_samples, seed):
+def _random_transitions(env_id, env_kwargs, n_samples, seed):
     """`n_samples` (state, action, reward) of the uniform random policy on training worlds
-    (seeds below ``2**40``), shuffled later by the folds."""
-    rules = _make_env({"env_id": env_id, **({"view": view} if view else {})}).unwrapped.rules
+    (seeds below ``2**40``), shuffled later by the folds; `env_kwargs` as sorted pairs."""
+    rules = gym.make(env_id, **dict(env_kwargs)).unwrapped.rules
     n_worlds = min(400, n_samples)
     worlds = envs.BatchedObjectWorld(n_worlds, **dataclasses.asdict(rules))
     rng = np.random.default_rng(seed)
@@ -147,8 +152,8 @@ def _rmse(params, budget, seed, samples):
     """Appendix A: k-fold cross-validated RMSE of the first FQI iteration's regression
     (targets = immediate rewards), per action, averaged over the actions."""
     env = _make_env(params)
-    states, actions, rewards = _random_transitions(params["env_id"], params.get("view"),
-                                                   budget.rmse_samples, seed)
+    states, actions, rewards = _random_transitions(
+        params["env_id"], tuple(sorted(_env_kwargs(params).items())), budget.rmse_samples, seed)
     template = _regressor(params, env, budget, seed)
     folds = KFold(budget.rmse_folds, shuffle=True, random_state=seed)
     per_action = []
@@ -210,7 +215,8 @@ def _sb3(params, budget, seed, samples):
     model = {"DQN": DQN, "PPO": PPO}[params["algo"]](
         "MlpPolicy", train_env, seed=seed, device="cpu", **hyperparams)
     model.set_logger(Logger(None, []))  # SB3's default logger makes a folder per run
-    eval_wrapper = wrap(_make_env(params))    # pads or counts the evaluation's observations
+    eval_env = _make_env(params)
+    eval_wrapper = wrap(eval_env)    # pads or counts the evaluation's observations
     policy = _WrappedPolicy(model, eval_wrapper)
     reference = _reference_seeds(eval_wrapper, budget)
     due = [round(steps * (k + 1) / params["checkpoints"]) for k in range(params["checkpoints"])]
@@ -218,7 +224,7 @@ def _sb3(params, budget, seed, samples):
 
     def checkpoint(model_steps):
         start = time.perf_counter()
-        total = evaluate(policy, params["env_id"], seeds=reference).total
+        total = evaluate(policy, eval_env, seeds=reference).total
         curve.append([int(model_steps), total * budget.reward_scale])
         eval_seconds[0] += time.perf_counter() - start
 
@@ -248,7 +254,7 @@ def _policy(params, budget, seed, samples):
     the ceiling, it plays with the simulator), "greedy" (`envs.GreedyPolicy`, scripted) or
     "random" (uniform, action seed `seed`). Played through `fqi.evaluate`, as the learners."""
     reference = _reference_seeds(_make_env(params), budget)
-    worlds = gym.make_vec(params["env_id"], num_envs=len(reference))
+    worlds = gym.make_vec(params["env_id"], num_envs=len(reference), **_env_kwargs(params))
     if params["policy"] == "planner":
         planner = envs.LookaheadPlanner(depth=params["depth"], width=params["width"])
         policy = _PlannerPolicy(planner, worlds)
