@@ -20,8 +20,8 @@ all transitions kept (up to 100,000), and the tuned DQN's exploration schedule: 
 falls linearly from 1 to DQN's final epsilon over DQN's exploration fraction of the budget.
 
 With MushroomRL installed, its ``FQI`` runs beside ours on CartPole with the same regressor,
-the protocol it supports (Ernst 2005, offline): 10,000 transitions of the random policy, 20
-iterations; compared by the return of the greedy policy and the seconds per iteration.
+the protocol it supports (offline, as first formulated): 10,000 transitions of the random
+policy, 20 iterations; compared by the return of the greedy policy and the seconds per iteration.
 MushroomRL 1.10.2 pins an old torch and numpy, so install it without them:
 ``.venv/bin/pip install --no-deps mushroom-rl==1.10.2 opencv-python-headless pygame``.
 

@@ -1,4 +1,4 @@
-"""The ObjectWorld game of Blank (2015) as gymnasium environments, single and batched.
+"""The ObjectWorld game of the thesis as gymnasium environments, single and batched.
 
 Importing this package registers
 

@@ -99,7 +99,7 @@ def _check_action(action, n_actions):
 
 
 class ObjectWorldEnv(_OwnEpisodeLimit, gym.Env):
-    """The ObjectWorld game of Blank (2015): collect money, avoid enemies, don't hit walls.
+    """The thesis's ObjectWorld game: collect money, avoid enemies, don't hit walls.
 
     The world is the square ``[-size_w, size_w]^2`` with a wall-lined border, filled at reset
     with money (+100 when touched, then removed), walls (-50 when touched; they cancel the

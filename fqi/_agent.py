@@ -33,8 +33,8 @@ _LEARNED = ("q_functions_", "history", "num_timesteps", "iteration", "observatio
 
 
 class FQI:
-    """Fitted Q-iteration (Ernst et al. 2005) on any gymnasium env with discrete actions,
-    in the data regimes of Blank (2015), 3.2.2.
+    """Fitted Q-iteration on any gymnasium env with discrete actions, in the data regimes
+    of the thesis (section 3.2.2).
 
     The Q-function is one regressor per action, each a fresh `sklearn.base.clone` of
     `regressor` fitted at every iteration; the agent only calls ``fit(X, y)`` and
@@ -86,7 +86,8 @@ class FQI:
         Transitions collected per collection (thesis: 20,000).
     resample_every : int or None, default=1
         Collect new data every this many iterations: 1 is the thesis's "normal" regime,
-        5 its "mixed" one; None collects only at iteration 0 (offline FQI, Ernst 2005).
+        5 its "mixed" one; None collects only at iteration 0 (offline FQI, as first
+        formulated).
     keep_data : bool, default=False
         Append new transitions to the earlier ones instead of replacing them, keeping the
         most recent `max_samples` (a cure for the forgetting the thesis blames for its
