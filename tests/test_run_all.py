@@ -40,7 +40,8 @@ def test_registry_covers_every_thesis_figure_once():
         "search_dqn_grid", "search_dqn_objects", "search_ppo_objects"}
     ablations = [e for e in EXPERIMENTS if e.explains]
     assert {name for e in ablations for name in e.explains} == {
-        "rmse_K", "rmse_nmin", "rmse_TW", "rmse_grid", "fqi_grid", "representations"}
+        "rmse_K", "rmse_nmin", "rmse_TW", "rmse_grid", "fqi_grid", "representations",
+        "fqi_TW", "sampling", "sword"}
     for ablation in ablations:
         assert ablation.figure == "extra" and ablation.hypothesis and ablation.findings
         assert all(REGISTRY[name].figure != "extra" for name in ablation.explains)
@@ -438,6 +439,14 @@ def test_other_rules():
     assert NearRandom("b", "a", "").check({"a": a, "b": _stats("b", -90, random_reward=-100)}
                                           ).holds is True
     assert HighestPeak("a", ("a", "b"), "").check(stats).holds is True
+    peaks = {"a": _stats("a", 0, best=300, mean_peak=100), "b": _stats("b", 0, best=200,
+                                                                      mean_peak=150)}
+    assert HighestPeak("a", ("a", "b"), "").check(peaks).holds is True
+    assert HighestPeak("a", ("a", "b"), "", of_mean=True).check(peaks).holds is False
+    spread = {"a": _stats("a", 0, instability=5, spread=50), "b": _stats("b", 0,
+                                                                         instability=9, spread=10)}
+    assert MoreStable("a", ("b",), "").check(spread).holds is True
+    assert MoreStable("a", ("b",), "", measure="spread").check(spread).holds is False
     assert Falls(("b", "a"), "").check(stats).holds is True
     timed = {"a": _stats("a", 100, seconds=50.0), "b": _stats("b", 0, seconds=100.0)}
     assert Faster("a", ("b",), 0.5, "").check(timed).holds is True
@@ -455,6 +464,7 @@ def test_summarise_fqi_runs():
     assert s.score == pytest.approx((10 + 70 / 3) / 2)  # mean of all 3 iterations (< 5)
     assert s.curve_mean.tolist() == [-6.0, 0.0, 20.0, 30.0]
     assert s.instability == pytest.approx(15.0) and s.best == 40.0 and s.seconds == 3.0
+    assert s.mean_peak == 30.0 and s.spread == pytest.approx(20 / 3)  # sd 0, 10, 10
 
 
 # ------------------------------------------------------------------------------ report

@@ -125,24 +125,31 @@ class Similar(_Rule):
                        f"{_NOISE_SE:g} SE = {_fmt(_NOISE_SE * se)}")
 
 
+_STABILITY = {"changes": ("instability", "mean |change| between iterations"),
+              "spread": ("spread", "sd over runs, mean over iterations")}
+
+
 @dataclass(frozen=True)
 class MoreStable(_Rule):
-    """`stable` changes less between consecutive iterations than each of `others`."""
+    """`stable` varies less than each of `others`: between consecutive iterations
+    (``measure="changes"``), or from run to run (``"spread"``, the width of the band)."""
 
     stable: str
     others: tuple
     claim: str
+    measure: str = "changes"
 
     def _needs(self):
         return (self.stable, *self.others)
 
     def _judge(self, stats):
-        values = {label: stats[label].instability for label in (self.stable, *self.others)}
+        field, what = _STABILITY[self.measure]
+        values = {label: getattr(stats[label], field) for label in self._needs()}
         if any(math.isnan(v) for v in values.values()):
             return Verdict(self.claim, None, "needs at least 2 iterations")
         holds = all(values[self.stable] < values[o] for o in self.others)
         listed = ", ".join(f"{label} {_fmt(v)}" for label, v in values.items())
-        return Verdict(self.claim, holds, f"mean |change| between iterations: {listed}")
+        return Verdict(self.claim, holds, f"{what}: {listed}")
 
 
 @dataclass(frozen=True)
@@ -187,16 +194,21 @@ class NearRandom(_Rule):
 
 @dataclass(frozen=True)
 class HighestPeak(_Rule):
-    """`label` reaches the best single evaluation among `labels`."""
+    """`label` reaches the best single evaluation among `labels` (of any run), or with
+    ``of_mean=True`` the highest point of the mean curve over runs."""
 
     label: str
     labels: tuple
     claim: str
+    of_mean: bool = False
 
     def _judge(self, stats):
-        winner = max(self.labels, key=lambda label: stats[label].best)
-        listed = ", ".join(f"{label} {_fmt(stats[label].best)}" for label in self.labels)
-        return Verdict(self.claim, winner == self.label, f"best single evaluation: {listed}")
+        field, what = (("mean_peak", "peak of the mean curve") if self.of_mean
+                       else ("best", "best single evaluation"))
+        winner = max(self.labels, key=lambda label: getattr(stats[label], field))
+        listed = ", ".join(f"{label} {_fmt(getattr(stats[label], field))}"
+                           for label in self.labels)
+        return Verdict(self.claim, winner == self.label, f"{what}: {listed}")
 
 
 @dataclass(frozen=True)

@@ -36,6 +36,11 @@ class SettingStats:
     instability : float
         FQI: mean absolute change of the reward between consecutive iterations (after
         iteration 1), averaged over runs; NaN otherwise.
+    mean_peak : float
+        FQI: the highest point of the mean curve over runs (iteration 1 on).
+    spread : float
+        FQI: the sd of the reward over runs, averaged over the iterations (1 on): the
+        width of the figure's band.
     random_reward : float
         FQI: mean reward of the uniform random policy on the same evaluation.
     seconds : float
@@ -53,6 +58,8 @@ class SettingStats:
     curve_sd: np.ndarray = None
     best: float = np.nan
     instability: float = np.nan
+    mean_peak: float = np.nan
+    spread: float = np.nan
     random_reward: float = np.nan
     seconds: float = np.nan
 
@@ -83,6 +90,8 @@ def summarise(label, kind, runs):
             curve_mean=curves.mean(axis=0), curve_sd=curves.std(axis=0),
             best=float(curves[:, 1:].max()),
             instability=float(changes.mean()) if changes.size else np.nan,
+            mean_peak=float(curves[:, 1:].mean(axis=0).max()),
+            spread=float(curves[:, 1:].std(axis=0).mean()),
             random_reward=float(curves[:, 0].mean()), seconds=seconds)
     if kind == "rmse":
         folds = np.array([r["fold_rmse"] for r in runs])
