@@ -680,9 +680,14 @@ def test_baseline_searches_run_when_named_with_their_own_seeds_and_curves(tmp_pa
                    "--out", str(tmp_path), "--no-progress"])
     search = REGISTRY["search_dqn_objects"]
     assert len(search.settings) == 8 and search.seeds == 2
+    # its own 2 seeds at the full and quick budgets, at most the budget's (1 at tiny)
+    assert runner.seeds_for(search, BUDGETS["full"]) == runner.seeds_for(
+        search, BUDGETS["quick"]) == [0, 1]
+    assert runner.seeds_for(search, TINY) == [0]
+    assert runner.seeds_for(REGISTRY["rmse_K_datasets"], BUDGETS["full"]) == list(range(5))
     for name in ("search_dqn_grid", "search_dqn_objects"):
         for label in REGISTRY[name].settings:
-            for seed in (0, 1):
+            for seed in runner.seeds_for(REGISTRY[name], TINY):
                 result = json.loads(unit_path(tmp_path, TINY, name, label, seed).read_text())["result"]
                 steps = [s for s, _ in result["curve"]]
                 assert len(steps) == 4 and steps == sorted(steps)

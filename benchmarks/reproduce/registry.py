@@ -54,7 +54,7 @@ class Experiment:
     notes : str
         Choices where the thesis is silent, for the report.
     seeds : int, default=None
-        Runs per setting, instead of the budget's.
+        Runs per setting, instead of the budget's (at most the budget's).
     on_demand : bool, default=False
         Run only when named (``--only``), and reported once it has runs: the baselines'
         hyperparameter searches.

@@ -64,16 +64,18 @@ class Unit:
 
 
 def seeds_for(experiment, budget, seeds=None):
-    """Seeds of an experiment: `seeds` if given (each once), else ``range(experiment.seeds
-    or budget.seeds)``; unless the experiment says, the RMSE study and the attention
-    figure use one data set / forest (seed 0), as the thesis, and a reference policy's
-    score one run.
+    """Seeds of an experiment: `seeds` if given (each once), else ``range(experiment.seeds)``
+    (at most the budget's seeds, so a smaller budget stays small) or ``range(budget.seeds)``;
+    unless the experiment says, the RMSE study and the attention figure use one data set /
+    forest (seed 0), as the thesis, and a reference policy's score one run.
 
     A ``same_as`` setting runs with the seeds of the experiment owning it."""
     if seeds is not None:
         return list(dict.fromkeys(seeds))
+    if experiment.seeds is not None:
+        return list(range(min(experiment.seeds, budget.seeds)))
     one = experiment.kind in ("rmse", "attention", "policy")
-    n = experiment.seeds or (1 if one else budget.seeds)
+    n = 1 if one else budget.seeds
     return list(range(n))
 
 
