@@ -30,8 +30,19 @@ _DEFAULT_BANDS = 8
 _INT32_MAX = 2**31 - 1
 
 
-_POOLS = {}  # (process id, threads) -> the prediction threads
+_POOLS = {}  # threads -> the prediction threads of this process
 _POOLS_LOCK = threading.Lock()
+
+
+def _forget_pools_after_fork():
+    """In a forked child: the parent's threads are gone, and the lock may have been held."""
+    global _POOLS_LOCK
+    _POOLS.clear()
+    _POOLS_LOCK = threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_pools_after_fork)
 
 
 def _thread_pool(n_threads):
@@ -40,13 +51,14 @@ def _thread_pool(n_threads):
     Predictions are called once per environment step on batches of a few hundred samples,
     where starting threads (as a joblib ``Parallel`` call does) costs about as much as the
     work; the kernels release the GIL, so long-lived threads share a batch at no such cost.
-    A forked child starts its own pool (threads do not survive a fork).
+    So prediction takes its number of threads from ``n_jobs`` (and joblib's
+    ``parallel_config(n_jobs=...)``), not a joblib backend. A forked child starts its own.
     """
-    key = (os.getpid(), n_threads)
     with _POOLS_LOCK:
-        if key not in _POOLS:
-            _POOLS[key] = ThreadPoolExecutor(n_threads, thread_name_prefix="boxtrees-predict")
-        return _POOLS[key]
+        if n_threads not in _POOLS:
+            _POOLS[n_threads] = ThreadPoolExecutor(n_threads,
+                                                   thread_name_prefix="boxtrees-predict")
+        return _POOLS[n_threads]
 
 
 class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
@@ -115,16 +127,17 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         sets, _ = self._validate_input(X, reset=False)
         n = len(sets)
         out = out(n)
+        packed = self._packed  # one forest for every chunk, even if another thread refits
         n_chunks = n // _PREDICT_CHUNK_MIN
         if n_chunks > 1:  # effective_n_jobs costs as much as predicting one sample
             n_threads = effective_n_jobs(n_jobs)
             n_chunks = min(n_threads, n_chunks)
         if n_chunks <= 1:
-            results = [kernel(self._packed, sets.data, sets.offsets, out)]
+            results = [kernel(packed, sets.data, sets.offsets, out)]
         else:
             edges = np.linspace(0, n, n_chunks + 1).astype(np.intp)
             results = list(_thread_pool(n_threads).map(
-                lambda a, b: kernel(self._packed, sets.data, sets.offsets[a : b + 1], out[a:b]),
+                lambda a, b: kernel(packed, sets.data, sets.offsets[a : b + 1], out[a:b]),
                 edges[:-1], edges[1:],
             ))
         for problem, row in results:

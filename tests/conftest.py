@@ -2,3 +2,34 @@ import os
 
 # Let scikit-learn's array-API estimator checks run instead of skipping (must precede scipy).
 os.environ.setdefault("SCIPY_ARRAY_API", "1")
+
+
+def run_in_fork(check, timeout=60):
+    """Call ``check()`` in a forked child; whether it returned True there. A child that
+    hangs (say, on threads it did not inherit) is killed and fails the calling test."""
+    import signal
+    import time
+
+    import pytest
+
+    reader, writer = os.pipe()
+    pid = os.fork()
+    if pid == 0:
+        os.close(reader)
+        ok = False
+        try:
+            ok = bool(check())
+        finally:  # never back into the parent's pytest, whatever happened
+            os.write(writer, b"1" if ok else b"0")
+            os._exit(0)
+    os.close(writer)
+    deadline = time.monotonic() + timeout
+    while os.waitpid(pid, os.WNOHANG) == (0, 0):
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            pytest.fail("the forked child hung")
+        time.sleep(0.05)
+    answer = os.read(reader, 1)
+    os.close(reader)
+    return answer == b"1"

@@ -1,8 +1,6 @@
 """Correctness of BoxExtraTreesRegressor on object sets: traversal, learning, determinism."""
 import os
 import pickle
-import signal
-import time
 
 import joblib
 import numpy as np
@@ -11,6 +9,7 @@ from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.metrics import r2_score
 
 from boxtrees import BoxExtraTreesRegressor, GridCounts, ObjectSets, make_box_regression
+from conftest import run_in_fork
 
 TEST_TYPES = ("fixed", "bounded", "random", "classic")
 
@@ -170,23 +169,7 @@ def test_a_forked_child_predicts_on_threads_of_its_own():
     X, y = make_box_regression(500, random_state=0)
     forest = BoxExtraTreesRegressor(n_estimators=4, n_tests=20, n_jobs=2, random_state=0).fit(X, y)
     expected = forest.predict(X)  # the parent's prediction threads exist before the fork
-    reader, writer = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # the child: the parent's threads are gone; a hang here fails the wait below
-        os.close(reader)
-        ok = np.array_equal(forest.predict(X), expected)
-        os.write(writer, b"1" if ok else b"0")
-        os._exit(0)
-    os.close(writer)
-    deadline = time.monotonic() + 60
-    while os.waitpid(pid, os.WNOHANG) == (0, 0):
-        if time.monotonic() > deadline:
-            os.kill(pid, signal.SIGKILL)
-            os.waitpid(pid, 0)
-            pytest.fail("the forked child hung predicting on its parent's threads")
-        time.sleep(0.05)
-    assert os.read(reader, 1) == b"1"
-    os.close(reader)
+    assert run_in_fork(lambda: np.array_equal(forest.predict(X), expected))
 
 
 def test_dask_backend_builds_the_same_forest():

@@ -447,14 +447,21 @@ def test_other_rules():
                                                                          instability=9, spread=10)}
     assert MoreStable("a", ("b",), "").check(spread).holds is True
     assert MoreStable("a", ("b",), "", measure="spread").check(spread).holds is False
+    one_run = {"a": _stats("a", 0), "b": _stats("b", 0)}   # spread is NaN with one run
+    assert MoreStable("a", ("b",), "", measure="spread").check(one_run).explanation == \
+        "needs at least 2 runs"
+    with pytest.raises(ValueError, match="measure must be one of"):
+        MoreStable("a", ("b",), "", measure="band")
     assert Falls(("b", "a"), "").check(stats).holds is True
     timed = {"a": _stats("a", 100, seconds=50.0), "b": _stats("b", 0, seconds=100.0)}
     assert Faster("a", ("b",), 0.5, "").check(timed).holds is True
     assert Faster("a", ("b",), 0.4, "").check(timed).holds is False
     assert "a 0.8, b 1.7" in Faster("a", ("b",), 0.5, "").check(timed).explanation
-    assert AtLeast(("a", "b"), 100, "").check(stats).holds is True   # the best of them
-    assert AtLeast(("a", "b"), 101, "").check(stats).holds is False
-    assert AtLeast(("a", "b"), 1, "").check({"b": b}).holds is None  # not run: a
+    ref = {**stats, "ref": _stats("ref", 80)}
+    assert AtLeast(("a", "b"), "ref", 1.25, "").check(ref).holds is True   # the best of them
+    assert AtLeast(("a", "b"), "ref", 1.3, "").check(ref).holds is False
+    assert "goal 1.3 x ref 80 = 104" in AtLeast(("a", "b"), "ref", 1.3, "").check(ref).explanation
+    assert AtLeast(("a", "b"), "ref", 1.0, "").check({"b": b, "ref": b}).holds is None
 
 
 def test_summarise_fqi_runs():
@@ -465,6 +472,10 @@ def test_summarise_fqi_runs():
     assert s.curve_mean.tolist() == [-6.0, 0.0, 20.0, 30.0]
     assert s.instability == pytest.approx(15.0) and s.best == 40.0 and s.seconds == 3.0
     assert s.mean_peak == 30.0 and s.spread == pytest.approx(20 / 3)  # sd 0, 10, 10
+    assert np.isnan(summarise("x", "fqi", runs[:1]).spread)
+    rmse = [{"fold_rmse": [1.0, 3.0], "seconds": 1.0}, {"fold_rmse": [4.0, 6.0], "seconds": 1.0}]
+    assert summarise("x", "rmse", rmse[:1]).score_se == pytest.approx(np.sqrt(2) / np.sqrt(2))
+    assert summarise("x", "rmse", rmse).score_se == pytest.approx(np.std([2, 5], ddof=1) / np.sqrt(2))
 
 
 # ------------------------------------------------------------------------------ report
@@ -770,6 +781,16 @@ def test_each_ablation_is_reported_under_why_it_differs_in_the_sections_it_expla
             why = sections[name].split("### Why it differs", 1)[1]
             assert f"([{ablation.name}](#{ablation.name})," in why
             assert ablation.hypothesis in why
+            claims = [rule.claim for rule in REGISTRY[name].findings]
             for finding in summary[ablation.name]["findings"]:   # the computed verdicts
                 mark = {True: "yes", False: "no"}.get(finding["holds"], "n/a")
-                assert f"- {finding['claim']}: **{mark}**. {finding['explanation']}" in why
+                line = f"- {finding['claim']}: **{mark}**. {finding['explanation']}"
+                # listed where they re-check one of the section's own claims, only there
+                related = any(finding["claim"] == c or finding["claim"].endswith(f": {c}")
+                              for c in claims)
+                assert (line in why) == related, (name, line)
+            assert re.search(r"Shown( so far)?: (recovered in this ablation|undetermined|not "
+                             r"recovered)",
+                             why)
+    rep = sections["representations"].split("### Why it differs", 1)[1]
+    assert "grid + ridge reaches a positive reward: **" in rep and "10 > 15 > 21" not in rep

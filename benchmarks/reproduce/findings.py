@@ -125,8 +125,10 @@ class Similar(_Rule):
                        f"{_NOISE_SE:g} SE = {_fmt(_NOISE_SE * se)}")
 
 
-_STABILITY = {"changes": ("instability", "mean |change| between iterations"),
-              "spread": ("spread", "sd over runs, mean over iterations")}
+_STABILITY = {"changes": ("instability", "mean |change| between iterations",
+                          "needs at least 2 iterations"),
+              "spread": ("spread", "sd over runs, mean over iterations",
+                         "needs at least 2 runs")}
 
 
 @dataclass(frozen=True)
@@ -139,14 +141,19 @@ class MoreStable(_Rule):
     claim: str
     measure: str = "changes"
 
+    def __post_init__(self):
+        if self.measure not in _STABILITY:
+            raise ValueError(f"measure must be one of {sorted(_STABILITY)}, got "
+                             f"{self.measure!r}")
+
     def _needs(self):
         return (self.stable, *self.others)
 
     def _judge(self, stats):
-        field, what = _STABILITY[self.measure]
+        field, what, needs = _STABILITY[self.measure]
         values = {label: getattr(stats[label], field) for label in self._needs()}
         if any(math.isnan(v) for v in values.values()):
-            return Verdict(self.claim, None, "needs at least 2 iterations")
+            return Verdict(self.claim, None, needs)
         holds = all(values[self.stable] < values[o] for o in self.others)
         listed = ", ".join(f"{label} {_fmt(v)}" for label, v in values.items())
         return Verdict(self.claim, holds, f"{what}: {listed}")
@@ -247,13 +254,19 @@ class Faster(_Rule):
 
 @dataclass(frozen=True)
 class AtLeast(_Rule):
-    """The best score among `labels` reaches `value`."""
+    """The best score among `labels` reaches `ratio` times the score of `reference`."""
 
     labels: tuple
-    value: float
+    reference: str
+    ratio: float
     claim: str
+
+    def _needs(self):
+        return (*self.labels, self.reference)
 
     def _judge(self, stats):
         best = max(self.labels, key=lambda label: stats[label].score)
-        return Verdict(self.claim, stats[best].score >= self.value,
-                       f"best: {best} {_fmt(stats[best].score)} (goal {_fmt(self.value)})")
+        goal = self.ratio * stats[self.reference].score
+        return Verdict(self.claim, stats[best].score >= goal,
+                       f"best: {best} {_fmt(stats[best].score)}; goal {self.ratio:g} x "
+                       f"{self.reference} {_fmt(stats[self.reference].score)} = {_fmt(goal)}")

@@ -95,7 +95,8 @@ def _bars(experiment, stats, runs, budget):
 
 
 def _dqn(experiment, stats, runs, budget):
-    """Reward (mean +- sd over runs) and wall time per run of FQI and DQN."""
+    """Bars: reward (mean +- sd over runs) and wall time per run of each setting (FQI in
+    blue, the others: DQN, the searches' configurations, reference policies)."""
     fig, ax = plt.subplots(figsize=(6.5, 4))
     labels = list(stats)
     ax.bar(labels, [stats[label].score for label in labels],
@@ -117,11 +118,11 @@ def _versus_steps(experiment, stats, runs, budget):
     (its samples per iteration apart, the random policy at 0), the baselines at their
     checkpoints; reference policies as horizontal lines."""
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
-    drawn = []
+    references = 0
     for label, s in stats.items():
         if s.kind == "policy":
-            colour = _REFERENCE_COLOURS[sum(t.kind == "policy" for t in drawn)]
-            drawn.append(s)
+            colour = _REFERENCE_COLOURS[references % len(_REFERENCE_COLOURS)]
+            references += 1
             ax.axhline(s.score, ls="--", lw=1.0, color=colour)
             ax.annotate(f"{label} ({s.score:,.0f})", (0, s.score), xytext=(2, 3),
                         textcoords="offset points", fontsize=7, color=colour)

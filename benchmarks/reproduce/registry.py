@@ -7,7 +7,7 @@ instead of repeating them. ``findings`` are the thesis's claims as rules
 (`reproduce.findings`) checked on our numbers; ``thesis`` holds the thesis's numbers shown
 beside ours.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from .findings import (AtLeast, Falls, Faster, HighestPeak, MoreStable, NearRandom, Ranking,
                        Sign, Similar)
@@ -27,6 +27,24 @@ _REPRESENTATIONS = {
     "grid 10 + ridge": {"model": "grid", "n_bins": 10},
     "classic": {"test_type": "classic"},
 }
+
+
+# The thesis's claims that ablations re-check, each defined once: (ranking, claim) pairs
+# and rules.
+_K_CLAIM = ((("K=300",), ("K=50", "K=100", "K=500")), "K=300 gives the lowest RMSE")
+_NMIN_CLAIM = ((("n_min=20",), ("n_min=5", "n_min=10", "n_min=30", "n_min=50")),
+               "n_min between 15 and 25 gives the lowest RMSE")
+_TW_CLAIM = ((("TW=2.5",), ("TW=1", "TW=4")), "TW=2.5 gives the lowest RMSE")
+_GRID_RMSE_CLAIM = ((("N=16",), ("N=5", "N=10", "N=21")), "N=16 gives the lowest RMSE")
+_GRID_FQI_CLAIM = ((("N=10",), ("N=15",), ("N=21",)), "grid 10 > 15 > 21")
+_GRID_POSITIVE = "grid + ridge reaches a positive reward"
+_BOUNDED = ("bounded TW=1", "bounded TW=2.5", "bounded TW=4")
+_BOUNDED_PEAK = HighestPeak("bounded TW=4", _BOUNDED,
+                            "bounded boxes: TW=4 reaches the highest reward")
+_MIXED_RULES = (Ranking((("mixed (every 5)",), ("normal",)), "mixed has the higher mean"),
+                MoreStable("mixed (every 5)", ("normal",), "mixed is more stable"))
+_FIXED_UNSTABLE = MoreStable("bounded TW=4", ("fixed TW=1",),
+                             "fixed boxes are less stable than bounded ones")
 
 
 @dataclass(frozen=True)
@@ -54,7 +72,8 @@ class Experiment:
     notes : str
         Choices where the thesis is silent, for the report.
     seeds : int, default=None
-        Runs per setting, instead of the budget's (at most the budget's).
+        Runs per setting, instead of the default (the budget's seeds; one for the "rmse",
+        "attention" and "policy" kinds), at most the budget's.
     on_demand : bool, default=False
         Run only when named (``--only``), and reported once it has runs: the baselines'
         hyperparameter searches.
@@ -88,6 +107,11 @@ class Experiment:
     explains: tuple = ()
     hypothesis: str = ""
 
+    def __post_init__(self):
+        if not isinstance(self.explains, tuple):
+            raise TypeError(f"{self.name}: explains must be a tuple of experiment names, "
+                            f"got {self.explains!r}")
+
     def params(self, label, budget=None):
         """Full parameters of a setting (defaults, env and kind filled in), with the
         `budget`'s overrides for this experiment applied last."""
@@ -108,13 +132,11 @@ EXPERIMENTS = (
     _axis("rmse_K", "A.1", "RMSE vs number of tests K", "n_tests", (50, 100, 300, 500),
           lambda v: f"K={v}", _STANDARD, **_RMSE,
           thesis={"K=300": "lowest RMSE"},
-          findings=(Ranking((("K=300",), ("K=50", "K=100", "K=500")),
-                            "K=300 gives the lowest RMSE"),)),
+          findings=(Ranking(*_K_CLAIM),)),
     _axis("rmse_nmin", "A.2", "RMSE vs minimum node size n_min", "min_samples_split",
           (5, 10, 20, 30, 50), lambda v: f"n_min={v}", _STANDARD, **_RMSE,
           thesis={"n_min=20": "lowest (15-25 best)"},
-          findings=(Ranking((("n_min=20",), ("n_min=5", "n_min=10", "n_min=30", "n_min=50")),
-                            "n_min between 15 and 25 gives the lowest RMSE"),)),
+          findings=(Ranking(*_NMIN_CLAIM),)),
     _axis("rmse_M", "A.3", "RMSE vs number of trees M", "n_estimators", (5, 10, 15, 30),
           lambda v: f"M={v}", _STANDARD, **_RMSE,
           thesis={"M=30": "lowest (falls with M; M=10 surprisingly low)"},
@@ -122,11 +144,11 @@ EXPERIMENTS = (
     _axis("rmse_TW", "A.4", "RMSE vs test width TW (fixed boxes)", "test_width",
           (1.0, 2.5, 4.0), lambda v: f"TW={v:g}", _STANDARD, **_RMSE,
           thesis={"TW=2.5": "lowest RMSE"},
-          findings=(Ranking((("TW=2.5",), ("TW=1", "TW=4")), "TW=2.5 gives the lowest RMSE"),)),
+          findings=(Ranking(*_TW_CLAIM),)),
     _axis("rmse_grid", "A.5", "RMSE vs grid size N (grid + ridge)", "n_bins", (5, 10, 16, 21),
           lambda v: f"N={v}", {"model": "grid"}, **_RMSE,
           thesis={"N=16": "lowest RMSE"},
-          findings=(Ranking((("N=16",), ("N=5", "N=10", "N=21")), "N=16 gives the lowest RMSE"),)),
+          findings=(Ranking(*_GRID_RMSE_CLAIM),)),
     # ---------------------------------------------------------------- 3.1: parameters
     _axis("fqi_nmin", "3.1", "FQI reward vs n_min", "min_samples_split", (10, 20, 30),
           lambda v: f"n_min={v}", _STANDARD, kind="fqi",
@@ -151,13 +173,11 @@ EXPERIMENTS = (
                 "fixed TW=4": "too big: bad", "bounded TW=4": "most stable, highest peak"},
         findings=(Ranking((("fixed TW=1",), ("fixed TW=2.5",), ("fixed TW=4",)),
                           "fixed boxes: TW=1 > 2.5 > 4"),
-                  HighestPeak("bounded TW=4", ("bounded TW=1", "bounded TW=2.5",
-                                               "bounded TW=4"),
-                              "bounded boxes: TW=4 reaches the highest reward"))),
+                  _BOUNDED_PEAK)),
     _axis("fqi_grid", "3.5", "FQI reward vs grid size N (grid + ridge)", "n_bins", (10, 15, 21),
           lambda v: f"N={v}", {"model": "grid"}, kind="fqi",
           thesis={"N=10": "best", "N=21": "worst"},
-          findings=(Ranking((("N=10",), ("N=15",), ("N=21",)), "grid 10 > 15 > 21"),)),
+          findings=(Ranking(*_GRID_FQI_CLAIM),)),
     # ---------------------------------------------------------------- 3.2: representations
     Experiment(
         "representations", "3.6", "State representations (4 actions)", "fqi",
@@ -169,7 +189,7 @@ EXPERIMENTS = (
         findings=(Ranking((("fixed TW=1", "bounded TW=4"), ("random box",),
                            ("grid 10 + ridge",), ("classic",)),
                           "fixed ~ bounded > random box > grid > classic"),
-                  Sign("grid 10 + ridge", True, "grid + ridge reaches a positive reward"))),
+                  Sign("grid 10 + ridge", True, _GRID_POSITIVE))),
     Experiment(
         "treasure", "3.8", "Treasure game: local view vs global information", "fqi",
         env_id="ObjectWorldTreasure-v0",
@@ -187,8 +207,7 @@ EXPERIMENTS = (
         settings={"normal": {"resample_every": 1}, "mixed (every 5)": {"resample_every": 5}},
         thesis={"mixed (every 5)": "more stable, higher mean",
                 "normal": "less stable; best single policy"},
-        findings=(Ranking((("mixed (every 5)",), ("normal",)), "mixed has the higher mean"),
-                  MoreStable("mixed (every 5)", ("normal",), "mixed is more stable")),
+        findings=_MIXED_RULES,
         notes="Fixed boxes TW=1 ('the same parametrization as the previous experiments')."),
     Experiment(
         "sword", "3.10", "Sword game (8 actions)", "fqi", env_id="ObjectWorldSword-v0",
@@ -200,8 +219,7 @@ EXPERIMENTS = (
                           "bounded ~ random box > classic > grid"),
                   Sign("classic", True, "classic trees reach a positive reward"),
                   Sign("grid 10 + ridge", False, "grid + ridge stays negative"),
-                  MoreStable("bounded TW=4", ("fixed TW=1",),
-                             "fixed boxes are less stable than bounded ones"))),
+                  _FIXED_UNSTABLE)),
     # ---------------------------------------------------------------- beyond the thesis
     Experiment(
         "keep_data", "extra", "Keeping earlier data (thesis future work) vs normal and mixed",
@@ -326,25 +344,24 @@ def _grid_of(values, label, key, other, other_values, other_label):
             for w in other_values for v in values}
 
 
-def _per_group(claim, ranking, group_values, group_label):
-    """`claim`'s Ranking re-checked within each group of settings (labels suffixed by the
-    group), e.g. once per ridge penalty."""
+def _per_group(ranking_claim, group_values, group_label):
+    """A ``(ranking, claim)`` re-checked within each group of settings (labels suffixed by
+    the group, claims prefixed by it), e.g. once per ridge penalty."""
+    ranking, claim = ranking_claim
     return tuple(Ranking(tuple(tuple(f"{label}, {group_label(w)}" for label in level)
                                for level in ranking), f"{group_label(w)}: {claim}")
                  for w in group_values)
 
 
-_K_CLAIM = ((("K=300",), ("K=50", "K=100", "K=500")), "K=300 gives the lowest RMSE")
-_NMIN_CLAIM = ((("n_min=20",), ("n_min=5", "n_min=10", "n_min=30", "n_min=50")),
-               "n_min between 15 and 25 gives the lowest RMSE")
 _DATASETS = ("One data set of 20,000 random-play samples (the thesis's protocol, and ours) "
              "gives one RMSE per setting; the gap the thesis reads may be smaller than what "
              "changes from one data set to the next. Tested: the same study on 5 data sets "
-             "(seeds 0-4).")
+             "(seeds 0-4; as many as the budget's seeds allow).")
 _RANDOM_BOXES = ("The appendix does not say which tests its forests drew; A.4 calls the test "
                  "width 'the alternative formulation', so A.1-A.3 likely used the first one, "
                  "random boxes, where we used fixed boxes TW=1 (the tests of 3.2 on). "
-                 "Tested: the study with random boxes, 5 data sets.")
+                 "Tested: the study with random boxes, on 5 data sets (at most the budget's "
+                 "seeds).")
 _RIDGE = ("The thesis gives no ridge penalty and no feature scaling for the grid; we used "
           "scikit-learn's alpha=1 on raw counts, next to no penalty for ~5,000 samples per "
           "action: a finer grid then has more weights to fit to the same noise. Tested: "
@@ -357,14 +374,14 @@ def _alpha(value):
 
 
 EXPERIMENTS += (
-    _axis("rmse_K_datasets", "extra", "A.1 ablation: RMSE vs K on 5 data sets", "n_tests",
+    _axis("rmse_K_datasets", "extra", "A.1 ablation: RMSE vs K on several data sets", "n_tests",
           (50, 100, 300, 500), lambda v: f"K={v}", _STANDARD, kind="rmse", seeds=5,
           findings=(Ranking(*_K_CLAIM),), explains=("rmse_K",), hypothesis=_DATASETS),
     _axis("rmse_K_random", "extra", "A.1 ablation: RMSE vs K with random boxes", "n_tests",
           (50, 100, 300, 500), lambda v: f"K={v}", {**_STANDARD, "test_type": "random"},
           kind="rmse", seeds=5, findings=(Ranking(*_K_CLAIM),), explains=("rmse_K",),
           hypothesis=_RANDOM_BOXES),
-    _axis("rmse_nmin_datasets", "extra", "A.2 ablation: RMSE vs n_min on 5 data sets",
+    _axis("rmse_nmin_datasets", "extra", "A.2 ablation: RMSE vs n_min on several data sets",
           "min_samples_split", (5, 10, 20, 30, 50), lambda v: f"n_min={v}", _STANDARD,
           kind="rmse", seeds=5, findings=(Ranking(*_NMIN_CLAIM),), explains=("rmse_nmin",),
           hypothesis=_DATASETS),
@@ -379,42 +396,37 @@ EXPERIMENTS += (
         settings={f"TW={w:g}, reach {r:g}": {  # the start stays clear of what acts on it
             "test_width": w, "rules": {"contact_radius": r, "start_clearance": max(1.5, r)}}
                   for r in (1.2, 2.0) for w in (1.0, 2.5, 4.0)},
-        findings=_per_group("TW=2.5 gives the lowest RMSE", (("TW=2.5",), ("TW=1", "TW=4")),
-                            (1.2, 2.0), lambda r: f"reach {r:g}"),
+        findings=_per_group(_TW_CLAIM, (1.2, 2.0), lambda r: f"reach {r:g}"),
         explains=("rmse_TW",),
         hypothesis="An immediate reward depends on the objects the agent touches; in our game "
                    "an object acts within 0.6 units (`contact_radius`, our choice: the thesis "
                    "gives no sizes), one step, which a 2x2 box (TW=1) around the next "
                    "position covers. If the thesis's objects act from further away, a wider "
-                   "box fits better. Tested: contact radius 1.2 and 2.0, 3 data sets."),
+                   "box fits better. Tested: contact radius 1.2 and 2.0, on 3 data sets (at most the budget's "
+                   "seeds)."),
     Experiment(
         "rmse_grid_alpha", "extra", "A.5 ablation: RMSE vs grid size under a stronger ridge "
         "penalty", "rmse", defaults={"model": "grid"}, seeds=3,
         settings=_grid_of((5, 10, 16, 21), lambda v: f"N={v}", "n_bins", "alpha",
                           _ALPHAS_RMSE, _alpha),
-        findings=_per_group("N=16 gives the lowest RMSE", (("N=16",), ("N=5", "N=10", "N=21")),
-                            _ALPHAS_RMSE, _alpha),
+        findings=_per_group(_GRID_RMSE_CLAIM, _ALPHAS_RMSE, _alpha),
         explains=("rmse_grid",), hypothesis=_RIDGE),
     Experiment(
         "fqi_grid_alpha", "extra", "3.5 / 3.6 ablation: FQI on grid counts under a stronger "
         "ridge penalty", "fqi", defaults={"model": "grid"},
         settings=_grid_of((10, 15, 21), lambda v: f"N={v}", "n_bins", "alpha", _ALPHAS_FQI,
                           _alpha),
-        findings=(_per_group("grid 10 > 15 > 21", (("N=10",), ("N=15",), ("N=21",)),
-                             _ALPHAS_FQI, _alpha)
-                  + tuple(Sign(f"N=10, {_alpha(w)}", True,
-                               f"{_alpha(w)}: grid 10 + ridge reaches a positive reward")
+        findings=(_per_group(_GRID_FQI_CLAIM, _ALPHAS_FQI, _alpha)
+                  + tuple(Sign(f"N=10, {_alpha(w)}", True, f"{_alpha(w)}: {_GRID_POSITIVE}")
                           for w in _ALPHAS_FQI)),
         explains=("fqi_grid", "representations"), hypothesis=_RIDGE),
 )
 
-_BOUNDED = ("bounded TW=1", "bounded TW=2.5", "bounded TW=4")
 EXPERIMENTS += (
     Experiment(
         "fqi_TW_mean_peak", "extra", "3.4 ablation: the highest reward read off the mean "
         "curve", "fqi", settings={label: {"same_as": f"fqi_TW/{label}"} for label in _BOUNDED},
-        findings=(HighestPeak("bounded TW=4", _BOUNDED, "bounded boxes: TW=4 reaches the "
-                              "highest reward", of_mean=True),),
+        findings=(replace(_BOUNDED_PEAK, of_mean=True),),
         explains=("fqi_TW",),
         hypothesis="The thesis reads 'highest' off its figure, the mean curve over 5 runs; "
                    "we took the best single evaluation of any run, the maximum of 100 noisy "
@@ -423,8 +435,7 @@ EXPERIMENTS += (
         "sampling_gamma", "extra", "3.9 ablation: normal vs mixed with a longer horizon "
         "(gamma 0.9)", "fqi", defaults={**_TUNED, "gamma": 0.9},
         settings={"normal": {"resample_every": 1}, "mixed (every 5)": {"resample_every": 5}},
-        findings=(Ranking((("mixed (every 5)",), ("normal",)), "mixed has the higher mean"),
-                  MoreStable("mixed (every 5)", ("normal",), "mixed is more stable")),
+        findings=_MIXED_RULES,
         explains=("sampling",),
         hypothesis="The thesis gives no discount factor; we use 0.5 (the best of a sweep, "
                    "docs/fqi.md). Between two collections the mixed regime iterates on the "
@@ -436,8 +447,7 @@ EXPERIMENTS += (
         "fqi", env_id="ObjectWorldSword-v0", sample_scale=2.0,
         settings={label: {"same_as": f"sword/{label}"} for label in ("bounded TW=4",
                                                                       "fixed TW=1")},
-        findings=(MoreStable("bounded TW=4", ("fixed TW=1",), "fixed boxes are less stable "
-                             "than bounded ones", measure="spread"),),
+        findings=(replace(_FIXED_UNSTABLE, measure="spread"),),
         explains=("sword",),
         hypothesis="The thesis calls fixed boxes 'extremely unstable' from its figure, where "
                    "instability shows as a wide band over the 5 runs; we measured the change "
@@ -454,7 +464,7 @@ _REFERENCE_NOTES = ("An upper reference, not a learner: the planner (envs.Lookah
                     "action sequences on the copies. Scored on the same reference worlds "
                     "as every learner.")
 _FQI_BOX, _FQI_KEEP = "box FQI, fixed TW=1", "box FQI, keeping data (100k)"
-_TUNED_BASELINES = {  # the best configuration of each search (table in the report)
+_TUNED_BASELINES = {  # the best configuration of each finished search (its table: the report)
     "DQN on grid counts (tuned)": {"algo": "DQN", "observation": "grid", "n_bins": 10,
                                    "hyperparams": _DQN_SEARCH["MountainCar, gamma 0.9"]},
 }
@@ -483,8 +493,8 @@ EXPERIMENTS += (
                           "box FQI beats every tuned neural baseline at equal env steps"),
                   Faster(_FQI_BOX, tuple(_TUNED_BASELINES), 0.5,
                          "box FQI needs at most half the wall time of each baseline"),
-                  AtLeast((_FQI_BOX, _FQI_KEEP), 240_000,
-                          "a learner of ours reaches 240,000 (20 % above the heuristic)")),
+                  AtLeast((_FQI_BOX, _FQI_KEEP), "greedy heuristic", 1.2,
+                          "a learner of ours scores 20 % above the scripted heuristic")),
         notes="Every method gets one FQI run's 400,000 environment steps; the baselines "
               "train with one torch thread each, FQI's forests on every core (wall "
               "times are per run). Scores: FQI the mean of its last 5 iterations, the "

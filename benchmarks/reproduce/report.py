@@ -64,7 +64,7 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
         ablations = [(REGISTRY[other], measured[other]) for other in measured
                      if name in REGISTRY[other].explains]
         sections.append(_section(experiment, stats, runs, verdicts, done, planned)
-                        + _why_it_differs(ablations))
+                        + _why_it_differs(experiment, ablations))
         rows.extend((experiment, v, done, planned) for v in verdicts)
         if not experiment.findings:
             rows.append((experiment, None, done, planned))
@@ -93,7 +93,8 @@ def _header(experiments, budget, seeds, elapsed, n_run):
         f"Written by `python benchmarks/run_all.py` on {time.strftime('%Y-%m-%d %H:%M')}."
         f"{timing} Finished runs are cached under `runs/{budget.name}/`; re-running the "
         f"command resumes.\n\n"
-        f"Budget `{budget.name}`: {budget.seeds} run(s) per setting"
+        f"Budget `{budget.name}`: {budget.seeds} run(s) per setting (fewer where an "
+        f"experiment says)"
         f"{'' if seeds is None else f' (this invocation: seeds {list(seeds)})'}, "
         f"{budget.iterations} iterations x {budget.samples:,} samples (x2 for the sword game), "
         f"greedy evaluation over {budget.eval_steps:,} steps on the fixed reference worlds"
@@ -143,30 +144,43 @@ def _section(experiment, stats, runs, verdicts, done, planned):
     if verdicts:
         whose = "Claims" if experiment.figure == "extra" else "Thesis findings"
         lines += ["", f"{whose}, checked on these numbers:", ""]
-        lines += [f"- {v.claim}: **{v.mark}**. {v.explanation}" for v in verdicts]
+        lines += _verdict_lines(verdicts)
     if experiment.notes:
         lines += ["", f"Notes: {experiment.notes}"]
     return "\n".join(lines + [""])
 
 
-def _why_it_differs(ablations):
-    """The "Why it differs" part of a section: each ablation's hypothesis, and the thesis's
-    claim re-checked under it."""
+def _why_it_differs(experiment, ablations):
+    """The "Why it differs" part of a section: each ablation's hypothesis, and the claims of
+    `experiment` it re-checks (as they are, or prefixed by the ablation's setting)."""
     if not ablations:
         return ""
+    claims = [rule.claim for rule in experiment.findings]
     lines = ["", "### Why it differs", ""]
     for ablation, (stats, _, verdicts, done, planned) in ablations:
+        partial = "" if done == planned else f" **Partial: {done} of {planned} runs.**"
         lines += [f"**Hypothesis** ([{ablation.name}](#{ablation.name}), {done}/{planned} "
-                  f"runs): {ablation.hypothesis}", ""]
+                  f"runs):{partial} {ablation.hypothesis}", ""]
         if not stats:
             lines += ["Not run at this budget yet.", ""]
             continue
-        lines += [f"- {v.claim}: **{v.mark}**. {v.explanation}" for v in verdicts]
-        recovered = [v.claim for v in verdicts if v.holds]
-        lines += ["", "Shown: " + (f"recovered in this ablation: {'; '.join(recovered)}."
-                                   if recovered else "the thesis's finding is not recovered "
-                                   "in this ablation either."), ""]
+        related = [v for v in verdicts
+                   if any(v.claim == c or v.claim.endswith(f": {c}") for c in claims)]
+        lines += _verdict_lines(related)
+        recovered = [v.claim for v in related if v.holds]
+        undecided = [v.claim for v in related if v.holds is None]
+        if recovered:
+            shown = f"recovered in this ablation: {'; '.join(recovered)}."
+        elif undecided:
+            shown = f"undetermined: not enough runs for {'; '.join(undecided)}."
+        else:
+            shown = "not recovered in this ablation."
+        lines += ["", f"Shown{' so far' if partial else ''}: {shown}", ""]
     return "\n".join(lines)
+
+
+def _verdict_lines(verdicts):
+    return [f"- {v.claim}: **{v.mark}**. {v.explanation}" for v in verdicts]
 
 
 def _table(experiment, stats, runs):
@@ -183,6 +197,8 @@ def _table(experiment, stats, runs):
             lines.append(f"| {label} | {s.score:.2f} | {sd:.2f} | {thesis.get(label, '')} |")
         return lines
     ceiling = stats.get(experiment.ceiling)
+    if ceiling is not None and not ceiling.score > 0:
+        ceiling = None  # a share of nothing, or of a loss, means nothing
     share = "" if ceiling is None else f" share of the {experiment.ceiling}'s |"
     lines = ["| setting | runs | score +- sd over runs |" + share + " best evaluation | "
              "mean abs. change between iterations | minutes per run | thesis |",
@@ -219,7 +235,8 @@ def _summary_entry(experiment, stats, verdicts, done, planned):
         "planned": planned,
         "settings": {label: {"n_runs": s.n_runs, "score": s.score, "score_sd": s.score_sd,
                              "score_se": s.score_se, "best": s.best,
-                             "instability": s.instability, "random_reward": s.random_reward,
+                             "instability": s.instability, "mean_peak": s.mean_peak,
+                             "spread": s.spread, "random_reward": s.random_reward,
                              "seconds": s.seconds, "thesis": experiment.thesis.get(label)}
                      for label, s in stats.items()},
         "findings": [{"claim": v.claim, "holds": v.holds, "explanation": v.explanation}

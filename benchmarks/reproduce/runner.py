@@ -46,7 +46,9 @@ class Unit:
         the progress bar's ETA."""
         p = self.params
         if p["kind"] == "policy":  # the planner: about a minute on the 4-action game
-            return 60.0 * budget.eval_steps / 20_000 if p["policy"] == "planner" else 1.0
+            actions = 2.0 if p["env_id"] == "ObjectWorldSword-v0" else 1.0
+            return (60.0 * actions ** 2 * budget.eval_steps / 20_000
+                    if p["policy"] == "planner" else 1.0)
         if p["kind"] in ("dqn", "sb3"):
             objects = 4.0 if p.get("observation") == "objects" else 1.0
             return (2.5e-3 * (budget.dqn_steps or budget.iterations * self.samples)
@@ -67,9 +69,8 @@ def seeds_for(experiment, budget, seeds=None):
     """Seeds of an experiment: `seeds` if given (each once), else ``range(experiment.seeds)``
     (at most the budget's seeds, so a smaller budget stays small) or ``range(budget.seeds)``;
     unless the experiment says, the RMSE study and the attention figure use one data set /
-    forest (seed 0), as the thesis, and a reference policy's score one run.
-
-    A ``same_as`` setting runs with the seeds of the experiment owning it."""
+    forest (seed 0), as the thesis, and a reference policy's score one run. (A ``same_as``
+    setting is run, and read, with the seeds of the experiment owning it.)"""
     if seeds is not None:
         return list(dict.fromkeys(seeds))
     if experiment.seeds is not None:

@@ -26,7 +26,8 @@ class SettingStats:
         Standard deviation of the per-run scores (0 with one run).
     score_se : float
         Standard error of `score` from every value it averages (last-window rewards of
-        every run, or every fold's RMSE): also defined for a single run.
+        every run; every fold's RMSE of one data set, or the per-data-set RMSEs of
+        several): also defined for a single run.
     lower_is_better : bool
         True for RMSE.
     curve_mean, curve_sd : ndarray or None
@@ -40,7 +41,7 @@ class SettingStats:
         FQI: the highest point of the mean curve over runs (iteration 1 on).
     spread : float
         FQI: the sd of the reward over runs, averaged over the iterations (1 on): the
-        width of the figure's band.
+        width of the figure's band; NaN with one run.
     random_reward : float
         FQI: mean reward of the uniform random policy on the same evaluation.
     seconds : float
@@ -91,13 +92,15 @@ def summarise(label, kind, runs):
             best=float(curves[:, 1:].max()),
             instability=float(changes.mean()) if changes.size else np.nan,
             mean_peak=float(curves[:, 1:].mean(axis=0).max()),
-            spread=float(curves[:, 1:].std(axis=0).mean()),
+            spread=float(curves[:, 1:].std(axis=0).mean()) if len(runs) > 1 else np.nan,
             random_reward=float(curves[:, 0].mean()), seconds=seconds)
     if kind == "rmse":
         folds = np.array([r["fold_rmse"] for r in runs])
         scores = folds.mean(axis=1)
+        # one data set: the folds' spread; several: how the score changes between data sets
+        se = _se(folds) if len(runs) == 1 else _se(scores)
         return SettingStats(label, kind, len(runs), float(scores.mean()), _sd(scores),
-                            _se(folds), lower_is_better=True, seconds=seconds)
+                            se, lower_is_better=True, seconds=seconds)
     if kind in ("dqn", "sb3", "policy"):
         rewards = np.array([r["reward"] for r in runs])
         return SettingStats(label, kind, len(runs), float(rewards.mean()), _sd(rewards),

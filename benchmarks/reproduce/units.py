@@ -253,10 +253,15 @@ def _policy(params, budget, seed, samples):
     ``params["policy"]`` is "planner" (`envs.LookaheadPlanner` with ``depth`` and ``width``:
     the ceiling, it plays with the simulator), "greedy" (`envs.GreedyPolicy`, scripted) or
     "random" (uniform, action seed `seed`). Played through `fqi.evaluate`, as the learners."""
-    reference = _reference_seeds(_make_env(params), budget)
+    if params["policy"] not in ("planner", "greedy", "random"):
+        raise ValueError(f"unknown reference policy {params['policy']!r}")
+    env = _make_env(params)
+    reference = _reference_seeds(env, budget)
+    env.close()
     worlds = gym.make_vec(params["env_id"], num_envs=len(reference), **_env_kwargs(params))
     if params["policy"] == "planner":
-        planner = envs.LookaheadPlanner(depth=params["depth"], width=params["width"])
+        planner = envs.LookaheadPlanner(**{k: params[k] for k in ("depth", "width")
+                                           if k in params})
         policy = _PlannerPolicy(planner, worlds)
     elif params["policy"] == "greedy":
         policy = envs.GreedyPolicy(worlds)
