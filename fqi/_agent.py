@@ -1,5 +1,6 @@
 """`FQI`: fitted Q-iteration with one scikit-learn regressor per action, on any gymnasium env."""
 import inspect
+import os
 import time
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -463,9 +464,11 @@ class FQI:
         if n_threads == 1:
             predictions = [model.predict(batch) for model in self.q_functions_]
         else:
-            if self._pool is None:
-                self._pool = ThreadPoolExecutor(n_threads)
-            predictions = self._pool.map(lambda model: model.predict(batch), self.q_functions_)
+            if self._pool is None or self._pool[0] != os.getpid():
+                # a forked child inherits the pool but not its threads: a pool of its own
+                self._pool = (os.getpid(), ThreadPoolExecutor(n_threads))
+            predictions = self._pool[1].map(lambda model: model.predict(batch),
+                                            self.q_functions_)
         q = np.empty((len(batch), self.n_actions))
         for action, prediction in enumerate(predictions):
             q[:, action] = _checked_prediction(

@@ -12,6 +12,7 @@ def run_in_fork(check, timeout=60):
 
     import pytest
 
+    time.sleep(0.2)  # let the parent's worker threads go idle, as they are between calls
     reader, writer = os.pipe()
     pid = os.fork()
     if pid == 0:

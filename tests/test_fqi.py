@@ -8,6 +8,7 @@ import gymnasium as gym
 import joblib
 import numpy as np
 import pytest
+from conftest import run_in_fork
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.exceptions import NotFittedError
 from sklearn.linear_model import Ridge
@@ -557,3 +558,14 @@ def test_transitions_concatenate_drops_unknown_next_values():
     join = ObjectSets.concatenate
     assert _Transitions.concatenate([known, known], join).next_values.tolist() == [1, 1, 1, 1]
     assert _Transitions.concatenate([known, unknown], join).next_values is None
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
+def test_a_forked_child_predicts_with_threads_of_its_own():
+    from sklearn.ensemble import ExtraTreesRegressor
+
+    agent = FQI(ExtraTreesRegressor(n_estimators=2, random_state=0), "CartPole-v1",
+                samples_per_iteration=200, eval_episodes=0, n_jobs=2, seed=0).learn(1)
+    obs = np.zeros((3, 4), dtype=np.float32)
+    expected = agent.q_values(obs)  # its thread pool exists before the fork
+    assert run_in_fork(lambda: np.array_equal(agent.q_values(obs), expected))
