@@ -403,8 +403,8 @@ EXPERIMENTS += (
                    "an object acts within 0.6 units (`contact_radius`, our choice: the thesis "
                    "gives no sizes), one step, which a 2x2 box (TW=1) around the next "
                    "position covers. If the thesis's objects act from further away, a wider "
-                   "box fits better. Tested: contact radius 1.2 and 2.0, on 3 data sets (at most the budget's "
-                   "seeds)."),
+                   "box fits better. Tested: contact radius 1.2 and 2.0, on 3 data sets (at "
+                   "most the budget's seeds)."),
     Experiment(
         "rmse_grid_alpha", "extra", "A.5 ablation: RMSE vs grid size under a stronger ridge "
         "penalty", "rmse", defaults={"model": "grid"}, seeds=3,

@@ -6,8 +6,8 @@ import time
 from pathlib import Path
 
 from .plots import ACTION_NAMES, TYPE_NAMES, plot_experiment
-from .registry import EXPERIMENTS, REGISTRY, resolve
-from .runner import gather, seeds_for
+from .registry import EXPERIMENTS, REGISTRY
+from .runner import gather, setting_units
 from .stats import LAST_WINDOW
 
 __all__ = ["write_outputs", "figure_name"]
@@ -50,7 +50,7 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
         stats, runs = gather(experiment, budget, out, seeds)
         if experiment.on_demand and not stats:
             continue
-        planned = sum(len(seeds_for(resolve(experiment, label)[0], budget, seeds))
+        planned = sum(len(setting_units(experiment, label, budget, out, seeds))
                       for label in experiment.settings)
         done = sum(s.n_runs for s in stats.values())
         measured[experiment.name] = (stats, runs, [rule.check(stats) for rule in

@@ -23,8 +23,8 @@ from .registry import resolve
 from .stats import summarise
 from .units import run_unit
 
-__all__ = ["Unit", "plan", "run", "gather", "seeds_for", "cluster", "ClusterError",
-           "MAX_ATTEMPTS"]
+__all__ = ["Unit", "plan", "setting_units", "run", "gather", "seeds_for", "cluster",
+           "ClusterError", "MAX_ATTEMPTS"]
 
 # A unit that crashed this many times is skipped (reported missing; the command fails).
 MAX_ATTEMPTS = 3
@@ -99,13 +99,24 @@ def plan(experiments, budget, out, seeds=None):
     units = {}
     for experiment in experiments:
         for label in experiment.settings:
-            owner, owner_label = resolve(experiment, label)
-            samples = int(budget.samples * owner.sample_scale)
-            for seed in seeds_for(owner, budget, seeds):
-                path = unit_path(out, budget, owner.name, owner_label, seed)
-                units.setdefault(path, Unit(owner.name, owner_label, seed,
-                                            owner.params(owner_label, budget), samples, path))
+            for unit in setting_units(experiment, label, budget, out, seeds):
+                units.setdefault(unit.path, unit)
     return list(units.values())
+
+
+def setting_units(experiment, label, budget, out, seeds=None):
+    """The units of one setting: its owner's (``same_as`` followed), at the owner's seeds.
+
+    Returns
+    -------
+    units : list of Unit
+    """
+    owner, owner_label = resolve(experiment, label)
+    samples = int(budget.samples * owner.sample_scale)
+    params = owner.params(owner_label, budget)
+    return [Unit(owner.name, owner_label, seed, params, samples,
+                 unit_path(out, budget, owner.name, owner_label, seed))
+            for seed in seeds_for(owner, budget, seeds)]
 
 
 def _execute(unit, budget):
@@ -438,14 +449,11 @@ def gather(experiment, budget, out, seeds=None):
     """
     stats, runs = {}, {}
     for label in experiment.settings:
-        owner, owner_label = resolve(experiment, label)
-        params = owner.params(owner_label, budget)
-        samples = int(budget.samples * owner.sample_scale)
-        records = [load_unit(unit_path(out, budget, owner.name, owner_label, seed), params,
-                             budget, samples, seed)
-                   for seed in seeds_for(owner, budget, seeds)]
+        units = setting_units(experiment, label, budget, out, seeds)
+        records = [load_unit(u.path, u.params, budget, u.samples, u.seed) for u in units]
         records = [r for r in records if r is not None]
         if records:
             runs[label] = records
-            stats[label] = summarise(label, params["kind"], [r["result"] for r in records])
+            stats[label] = summarise(label, units[0].params["kind"],
+                                     [r["result"] for r in records])
     return stats, runs
