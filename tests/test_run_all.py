@@ -707,15 +707,29 @@ def test_baseline_searches_run_when_named_with_their_own_seeds_and_curves(tmp_pa
     assert '<a id="search_ppo_objects"></a>' not in report.read_text()
 
 
-def test_a_ppo_run_on_the_objects_with_attention():
+@pytest.mark.parametrize("normalize", [False, True])
+def test_a_ppo_run_on_the_objects_with_attention(normalize, monkeypatch):
+    from stable_baselines3.common import vec_env
     from benchmarks.reproduce.units import run_unit
 
+    wrapped = []
+
+    class Recorded(vec_env.VecNormalize):
+        def __init__(self, venv, **kwargs):
+            wrapped.append(kwargs)
+            super().__init__(venv, **kwargs)
+
+    monkeypatch.setattr(vec_env, "VecNormalize", Recorded)
     params = {**REGISTRY["search_ppo_objects"].params("CartPole, gamma 0.9, attention"),
               "hyperparams": {"n_envs": 2, "n_steps": 32, "batch_size": 32, "n_epochs": 1,
-                              "gamma": 0.9}, "step_scale": 1.0, "max_objects": 32}
+                              "gamma": 0.9, "normalize": normalize},
+              "step_scale": 1.0, "max_objects": 32}
     result = run_unit(params, TINY, 0, TINY.samples)
     assert params["attention"] and result["total_timesteps"] >= TINY.dqn_steps
     assert len(result["curve"]) == 4 and np.isfinite(result["reward"])
+    # rewards only, at the run's discount; never the padded observations
+    assert wrapped == ([{"norm_obs": False, "norm_reward": True, "gamma": 0.9}]
+                       if normalize else [])
 
 
 def test_reference_policies_score_on_the_reference_worlds_as_learners_do():

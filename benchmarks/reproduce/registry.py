@@ -293,6 +293,9 @@ _ZOO_PPO = {  # LunarLander-v2
 _ZOO_PPO_CARTPOLE = {
     "n_envs": 8, "n_steps": 32, "batch_size": 256, "gae_lambda": 0.8, "n_epochs": 20,
     "ent_coef": 0.0, "learning_rate": 1e-3, "clip_range": 0.2}
+_ZOO_PPO_MOUNTAINCAR = {  # (Acrobot-v1: 256 steps, gae_lambda 0.94); both normalize rewards
+    "normalize": True, "n_envs": 16, "n_steps": 16, "gae_lambda": 0.98, "n_epochs": 4,
+    "ent_coef": 0.0}
 _PPO_SEARCH = {
     "LunarLander, gamma 0.9": {**_ZOO_PPO, "gamma": 0.9},
     "LunarLander, gamma 0.99": {**_ZOO_PPO, "gamma": 0.99},
@@ -303,6 +306,14 @@ _PPO_SEARCH = {
     "CartPole, gamma 0.98": {**_ZOO_PPO_CARTPOLE, "gamma": 0.98},
     "CartPole, gamma 0.9, 64 steps": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9, "n_steps": 64},
     "CartPole, gamma 0.9, ent 0.01": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9, "ent_coef": 0.01},
+    # rollouts sized to the budget (390 updates in 100,000 steps, the LunarLander ones 6),
+    # on normalized rewards: unscaled, returns of hundreds swamp the shared encoder
+    "MountainCar, gamma 0.9": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.9},
+    "MountainCar, gamma 0.99": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.99},
+    "Acrobot, gamma 0.9": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.9, "n_steps": 256,
+                           "gae_lambda": 0.94},
+    "CartPole, gamma 0.9, 64 steps, normalized": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9,
+                                                  "n_steps": 64, "normalize": True},
 }
 
 

@@ -188,20 +188,24 @@ def _sb3(params, budget, seed, samples):
     ``params``: ``algo`` ("DQN" or "PPO"), ``observation`` ("grid": `fqi.GridObservation`
     counts with ``n_bins``; "objects": `envs.PaddedObjects` of ``max_objects`` rows through
     `fqi.SetEncoder`, with ``attention``), ``hyperparams`` (the algorithm's keyword
-    arguments; ``n_envs`` training envs), ``step_scale`` (the share of one FQI run's
-    environment steps it gets).
+    arguments; ``n_envs`` training envs; ``normalize``, as in rl-zoo3: train on rewards
+    scaled by a running estimate of the return's spread, `VecNormalize` on rewards only,
+    since the observations hold padding rows and a presence mask), ``step_scale`` (the
+    share of one FQI run's environment steps it gets).
     """
     import torch
     from stable_baselines3 import DQN, PPO
     from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.logger import Logger
+    from stable_baselines3.common.vec_env import VecNormalize
 
     from fqi import SetEncoder   # imports torch: only here
 
     steps = round((budget.dqn_steps or budget.iterations * samples) * params["step_scale"])
     hyperparams = dict(params["hyperparams"])
     n_envs = hyperparams.pop("n_envs", 1)
+    normalize = hyperparams.pop("normalize", False)
     if params["observation"] == "grid":
         def wrap(env):
             return GridObservation(env, n_bins=params["n_bins"])
@@ -212,6 +216,9 @@ def _sb3(params, budget, seed, samples):
             **hyperparams.get("policy_kwargs", {}), "features_extractor_class": SetEncoder,
             "features_extractor_kwargs": {"attention": params["attention"]}}
     train_env = make_vec_env(lambda: wrap(_make_env(params)), n_envs=n_envs, seed=seed)
+    if normalize:  # the evaluation plays the raw env and counts raw rewards
+        train_env = VecNormalize(train_env, norm_obs=False, norm_reward=True,
+                                 gamma=hyperparams.get("gamma", 0.99))
     model = {"DQN": DQN, "PPO": PPO}[params["algo"]](
         "MlpPolicy", train_env, seed=seed, device="cpu", **hyperparams)
     model.set_logger(Logger(None, []))  # SB3's default logger makes a folder per run
