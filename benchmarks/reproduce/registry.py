@@ -490,6 +490,8 @@ _FQI_BOX, _FQI_KEEP = "box FQI, fixed TW=1", "box FQI, keeping data (100k)"
 _TUNED_BASELINES = {  # the best configuration of each finished search (its table: the report)
     "DQN on grid counts (tuned)": {"algo": "DQN", "observation": "grid", "n_bins": 10,
                                    "hyperparams": _DQN_SEARCH["MountainCar, gamma 0.9"]},
+    "DQN on the objects (tuned)": {"algo": "DQN", "observation": "objects",
+                                   "hyperparams": _DQN_SEARCH["CartPole, gamma 0.99"]},
 }
 EXPERIMENTS += (
     Experiment(
