@@ -314,6 +314,14 @@ _PPO_SEARCH = {
                            "gae_lambda": 0.94},
     "CartPole, gamma 0.9, 64 steps, normalized": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9,
                                                   "n_steps": 64, "normalize": True},
+    # then around the first of those to score above zero
+    "CartPole, gamma 0.98, 64 steps, normalized": {**_ZOO_PPO_CARTPOLE, "gamma": 0.98,
+                                                   "n_steps": 64, "normalize": True},
+    "CartPole, gamma 0.9, 128 steps, normalized": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9,
+                                                   "n_steps": 128, "normalize": True},
+    "CartPole, gamma 0.9, normalized": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9, "normalize": True},
+    "Acrobot, gamma 0.99": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.99, "n_steps": 256,
+                            "gae_lambda": 0.94},
 }
 
 
