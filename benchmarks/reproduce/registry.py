@@ -496,6 +496,9 @@ _REFERENCE_NOTES = ("An upper reference, not a learner: the planner (envs.Lookah
                     "as every learner.")
 _FQI_BOX, _FQI_KEEP = "box FQI, fixed TW=1", "box FQI, keeping data (100k)"
 _TUNED_BASELINES = {  # the best configuration of each finished search (its table: the report)
+    "PPO on the objects (tuned)": {
+        "algo": "PPO", "observation": "objects",
+        "hyperparams": _PPO_SEARCH["CartPole, gamma 0.9, 128 steps, normalized"]},
     "DQN on grid counts (tuned)": {"algo": "DQN", "observation": "grid", "n_bins": 10,
                                    "hyperparams": _DQN_SEARCH["MountainCar, gamma 0.9"]},
     "DQN on the objects (tuned)": {"algo": "DQN", "observation": "objects",
