@@ -307,7 +307,7 @@ _PPO_SEARCH = {
     "CartPole, gamma 0.9, 64 steps": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9, "n_steps": 64},
     "CartPole, gamma 0.9, ent 0.01": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9, "ent_coef": 0.01},
     # rollouts sized to the budget (390 updates in 100,000 steps, the LunarLander ones 6),
-    # on normalized rewards: unscaled, returns of hundreds swamp the shared encoder
+    # on normalized rewards (unscaled, the returns run to hundreds)
     "MountainCar, gamma 0.9": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.9},
     "MountainCar, gamma 0.99": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.99},
     "Acrobot, gamma 0.9": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.9, "n_steps": 256,
