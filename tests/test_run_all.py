@@ -716,8 +716,8 @@ def test_a_ppo_run_on_the_objects_with_attention(normalize, monkeypatch):
 
     class Recorded(vec_env.VecNormalize):
         def __init__(self, venv, **kwargs):
-            wrapped.append(kwargs)
             super().__init__(venv, **kwargs)
+            wrapped.append((kwargs, self))
 
     monkeypatch.setattr(vec_env, "VecNormalize", Recorded)
     params = {**REGISTRY["search_ppo_objects"].params("CartPole, gamma 0.9, attention"),
@@ -728,8 +728,10 @@ def test_a_ppo_run_on_the_objects_with_attention(normalize, monkeypatch):
     assert params["attention"] and result["total_timesteps"] >= TINY.dqn_steps
     assert len(result["curve"]) == 4 and np.isfinite(result["reward"])
     # rewards only, at the run's discount; never the padded observations
-    assert wrapped == ([{"norm_obs": False, "norm_reward": True, "gamma": 0.9}]
-                       if normalize else [])
+    assert [kwargs for kwargs, _ in wrapped] == (
+        [{"norm_obs": False, "norm_reward": True, "gamma": 0.9}] if normalize else [])
+    # and the model trained through it: its return statistics saw every step
+    assert all(env.ret_rms.count >= TINY.dqn_steps for _, env in wrapped)
 
 
 def test_reference_policies_score_on_the_reference_worlds_as_learners_do():

@@ -188,10 +188,10 @@ def _sb3(params, budget, seed, samples):
     ``params``: ``algo`` ("DQN" or "PPO"), ``observation`` ("grid": `fqi.GridObservation`
     counts with ``n_bins``; "objects": `envs.PaddedObjects` of ``max_objects`` rows through
     `fqi.SetEncoder`, with ``attention``), ``hyperparams`` (the algorithm's keyword
-    arguments; ``n_envs`` training envs; ``normalize``, as in rl-zoo3: train on rewards
+    arguments; ``n_envs`` training envs; ``normalize``, rl-zoo3's key: train on rewards
     scaled by a running estimate of the return's spread, `VecNormalize` on rewards only,
-    since the observations hold padding rows and a presence mask), ``step_scale`` (the
-    share of one FQI run's environment steps it gets).
+    where rl-zoo3 also scales observations, since these hold padding rows and a presence
+    mask), ``step_scale`` (the share of one FQI run's environment steps it gets).
     """
     import torch
     from stable_baselines3 import DQN, PPO
