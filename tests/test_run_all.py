@@ -416,6 +416,23 @@ def test_ranking_holds_fails_and_flags_noise():
     assert rule.check({"a": good["a"]}).holds is None  # settings not run
     assert rule.check({"a": good["a"]}).explanation == "not run: b, c"
     assert rule.check({}).explanation == "not run at this budget yet"
+    # false on the settings run so far: false whatever the missing one scores
+    partial = rule.check({"a": good["a"], "c": _stats("c", 120)})
+    assert partial.holds is False and partial.explanation.endswith("; not run: b")
+    assert "c not worse than a" in partial.explanation
+    assert rule.check({"a": good["a"], "c": good["c"]}).holds is None  # could still fail
+    assert rule.check({"a": good["a"], "b": _stats("b", 1)}).holds is None  # one group
+
+
+def test_faster_is_false_once_a_setting_run_so_far_breaks_it():
+    rule = Faster("a", ("b", "c"), 0.5, "a needs half the time")
+    stats = {label: _stats(label, 0, seconds=seconds)
+             for label, seconds in (("a", 10.0), ("b", 30.0), ("c", 15.0))}
+    assert rule.check(stats).holds is False
+    assert rule.check({k: stats[k] for k in "ab"}).holds is None       # c could be slower
+    partial = rule.check({k: stats[k] for k in "ac"})
+    assert partial.holds is False and partial.explanation.endswith("; not run: b")
+    assert rule.check({"b": stats["b"], "c": stats["c"]}).holds is None  # a not run
 
 
 def test_ranking_lower_is_better_for_rmse():

@@ -5,7 +5,7 @@ Each rule is a small frozen dataclass with a ``claim`` (the thesis's wording, sh
 here knows any result in advance: the verdicts come from the numbers only.
 """
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 __all__ = ["Verdict", "Ranking", "Similar", "MoreStable", "Sign", "NearRandom",
            "HighestPeak", "Falls", "Faster", "AtLeast"]
@@ -33,10 +33,17 @@ def _fmt(value):
 
 
 class _Rule:
-    """A claim about some settings: `check` reports the settings not run, else `_judge`s."""
+    """A claim about some settings: `check` `_judge`s it, or reports the settings not run;
+    a claim that is false on the settings run so far is false whatever the rest scores
+    when it holds of every pair or every other setting (`_on`)."""
 
     def _needs(self):
         return self.labels
+
+    def _on(self, present):
+        """The rule restricted to the settings `present`, if its being false on them makes
+        it false (it is a conjunction over its settings); else None."""
+        return None
 
     def check(self, stats):
         needs = self._needs()
@@ -44,7 +51,12 @@ class _Rule:
         if len(absent) == len(needs):
             return Verdict(self.claim, None, "not run at this budget yet")
         if absent:
-            return Verdict(self.claim, None, f"not run: {', '.join(absent)}")
+            missing = f"not run: {', '.join(absent)}"
+            part = self._on(set(needs) - set(absent))
+            verdict = part._judge(stats) if part is not None else None
+            if verdict is not None and verdict.holds is False:
+                return Verdict(self.claim, False, f"{verdict.explanation}; {missing}")
+            return Verdict(self.claim, None, missing)
         return self._judge(stats)
 
 
@@ -78,6 +90,11 @@ class Ranking(_Rule):
 
     def _needs(self):
         return [label for group in self.groups for label in group]
+
+    def _on(self, present):
+        groups = [kept for group in self.groups
+                  if (kept := tuple(label for label in group if label in present))]
+        return replace(self, groups=tuple(groups)) if len(groups) > 1 else None
 
     def _judge(self, stats):
         labels = self._needs()
@@ -244,6 +261,10 @@ class Faster(_Rule):
 
     def _needs(self):
         return (self.label, *self.others)
+
+    def _on(self, present):
+        others = tuple(label for label in self.others if label in present)
+        return replace(self, others=others) if self.label in present and others else None
 
     def _judge(self, stats):
         mine = stats[self.label].seconds
