@@ -293,9 +293,11 @@ _ZOO_PPO = {  # LunarLander-v2
 _ZOO_PPO_CARTPOLE = {
     "n_envs": 8, "n_steps": 32, "batch_size": 256, "gae_lambda": 0.8, "n_epochs": 20,
     "ent_coef": 0.0, "learning_rate": 1e-3, "clip_range": 0.2}
-_ZOO_PPO_MOUNTAINCAR = {  # (Acrobot-v1: 256 steps, gae_lambda 0.94); both normalize rewards
+_ZOO_PPO_MOUNTAINCAR = {  # both normalize rewards
     "normalize": True, "n_envs": 16, "n_steps": 16, "gae_lambda": 0.98, "n_epochs": 4,
     "ent_coef": 0.0}
+_ZOO_PPO_ACROBOT = {**_ZOO_PPO_MOUNTAINCAR, "n_steps": 256, "gae_lambda": 0.94}
+_CARTPOLE_NORMALIZED = {**_ZOO_PPO_CARTPOLE, "normalize": True}
 _PPO_SEARCH = {
     "LunarLander, gamma 0.9": {**_ZOO_PPO, "gamma": 0.9},
     "LunarLander, gamma 0.99": {**_ZOO_PPO, "gamma": 0.99},
@@ -310,18 +312,16 @@ _PPO_SEARCH = {
     # ones 6), on normalized rewards (the hypothesis: unscaled returns run to hundreds)
     "MountainCar, gamma 0.9": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.9},
     "MountainCar, gamma 0.99": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.99},
-    "Acrobot, gamma 0.9": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.9, "n_steps": 256,
-                           "gae_lambda": 0.94},
-    "CartPole, gamma 0.9, 64 steps, normalized": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9,
-                                                  "n_steps": 64, "normalize": True},
+    "Acrobot, gamma 0.9": {**_ZOO_PPO_ACROBOT, "gamma": 0.9},
+    "CartPole, gamma 0.9, 64 steps, normalized": {**_CARTPOLE_NORMALIZED, "gamma": 0.9,
+                                                  "n_steps": 64},
     # then 3 around the first of those to score above zero, and Acrobot at gamma 0.99
-    "CartPole, gamma 0.98, 64 steps, normalized": {**_ZOO_PPO_CARTPOLE, "gamma": 0.98,
-                                                   "n_steps": 64, "normalize": True},
-    "CartPole, gamma 0.9, 128 steps, normalized": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9,
-                                                   "n_steps": 128, "normalize": True},
-    "CartPole, gamma 0.9, normalized": {**_ZOO_PPO_CARTPOLE, "gamma": 0.9, "normalize": True},
-    "Acrobot, gamma 0.99": {**_ZOO_PPO_MOUNTAINCAR, "gamma": 0.99, "n_steps": 256,
-                            "gae_lambda": 0.94},
+    "CartPole, gamma 0.98, 64 steps, normalized": {**_CARTPOLE_NORMALIZED, "gamma": 0.98,
+                                                   "n_steps": 64},
+    "CartPole, gamma 0.9, 128 steps, normalized": {**_CARTPOLE_NORMALIZED, "gamma": 0.9,
+                                                   "n_steps": 128},
+    "CartPole, gamma 0.9, normalized": {**_CARTPOLE_NORMALIZED, "gamma": 0.9},
+    "Acrobot, gamma 0.99": {**_ZOO_PPO_ACROBOT, "gamma": 0.99},
 }
 
 
