@@ -64,11 +64,12 @@ class Budget:
 BUDGETS = {
     "full": Budget("full", seeds=5, iterations=20, samples=20_000, eval_steps=20_000,
                    rmse_samples=20_000, rmse_folds=10, attention_iterations=10),
-    # Measured on a quiet machine: one seed of every experiment took 4.2 min, so quick runs
-    # two (sd bands, noise-aware verdicts). The treasure game's global view holds ~360
-    # objects per state (local view ~40); with the thesis's M=30, K=500 its run cost 9x the
-    # local view's, so at this budget all four views of that figure get smaller forests.
-    "quick": Budget("quick", seeds=2, iterations=5, samples=4_000, eval_steps=8_000,
+    # Two seeds (sd bands, noise-aware verdicts) of every experiment within about 10 min on
+    # 2 cores (`make bench` runs two at a time): 5 x 4,000 took 24 min of run time, 40% of it
+    # the tuned baselines, whose steps follow the FQI run's. The treasure game's global view
+    # holds ~360 objects per state (local view ~40); with the thesis's M=30, K=500 its run
+    # cost 9x the local view's, so at this budget all four views get smaller forests.
+    "quick": Budget("quick", seeds=2, iterations=4, samples=3_000, eval_steps=8_000,
                     rmse_samples=5_000, rmse_folds=3, attention_iterations=3,
                     overrides={"treasure": {"n_estimators": 10, "n_tests": 200}}),
     # for the tests: every experiment end to end in seconds
