@@ -153,8 +153,9 @@ def run(units, budget, jobs=1, progress=True, client=None):
     units : list of Unit
     budget : Budget
     jobs : int, default=1
-        Parallel processes (joblib loky). Each FQI run already uses every core for its
-        forests, so 1 is usually fastest. Ignored with `client`.
+        Parallel processes (joblib loky). An FQI run's forests use every core, but its
+        simulation and the neural baselines use one, so on 2 cores 2 processes finish
+        first (`make bench` runs 2). Ignored with `client`.
     progress : bool, default=True
     client : distributed.Client, default=None
         Run the units as tasks on this Dask cluster (see `cluster`); this process writes
@@ -175,9 +176,10 @@ def run(units, budget, jobs=1, progress=True, client=None):
     crashes = {u.path: attempts(u.path) for u in units
                if load_unit(u.path, u.params, budget, u.samples, u.seed) is None}
     # Seed-major order, so an interrupted run leaves every setting with its first seeds
-    # done; units that crashed before go last, and are skipped after MAX_ATTEMPTS crashes.
+    # done; within a seed the longest first, so parallel processes end together; units that
+    # crashed before go last, and are skipped after MAX_ATTEMPTS crashes.
     todo = sorted((u for u in units if u.path in crashes),
-                  key=lambda u: (crashes[u.path], u.seed))
+                  key=lambda u: (crashes[u.path], u.seed, -u.cost(budget)))
     cached = len(units) - len(todo)
     skipped = [u for u in todo if crashes[u.path] >= MAX_ATTEMPTS]
     for u in skipped:
