@@ -1,6 +1,6 @@
 """Reproduce every experiment of the thesis, with plots and a report, in one command.
 
-    python benchmarks/run_all.py --quick          # every experiment, reduced budget, ~9 min
+    python benchmarks/run_all.py --quick --jobs 2 # every experiment, reduced budget, ~7 min
     python benchmarks/run_all.py                  # the thesis's budgets (many hours; resumable)
     python benchmarks/run_all.py --only representations,dqn --out docs/results
     python benchmarks/run_all.py --report-only    # rebuild figures and REPORT.md from the cache

@@ -333,6 +333,23 @@ def test_second_invocation_reuses_the_cache_and_resumes(tiny_run):
     assert units[2].path.exists() and units[0].path.stat().st_mtime_ns == before
 
 
+def test_units_run_seed_major_and_longest_first_within_a_seed(tmp_path, monkeypatch):
+    order = []
+
+    def record(params, budget, seed, samples):
+        order.append((seed, next(u for u in units if u.params == params
+                                 and u.seed == seed).cost(budget)))
+        return dict(_FQI_RESULT)
+
+    monkeypatch.setattr(runner, "run_unit", record)
+    units = plan([REGISTRY["fqi_M"]], TINY, tmp_path, seeds=[0, 1])  # M=5, 15, 30 each
+    run(units, TINY, progress=False)
+    assert [seed for seed, _ in order] == [0] * 3 + [1] * 3
+    for seed in (0, 1):
+        costs = [cost for s, cost in order if s == seed]
+        assert costs == sorted(costs, reverse=True) and costs[0] > costs[-1]
+
+
 def test_units_that_crashed_run_last_and_are_skipped_after_max_attempts(tiny_run):
     out, _ = tiny_run
     units = plan([REGISTRY["fqi_K"]], TINY, out)

@@ -102,7 +102,7 @@ def _parser():
     quick = BUDGETS["quick"]
     mode.add_argument("--quick", action="store_const", const="quick", dest="budget",
                       help=f"reduced budget ({quick.seeds} seeds, {quick.iterations} iterations x "
-                           f"{quick.samples:,} samples), ~24 min on 2 cores")
+                           f"{quick.samples:,} samples), ~7 min on 2 cores with --jobs 2")
     mode.add_argument("--budget", choices=sorted(BUDGETS),
                       help="named budget (default: full, the thesis's)")
     parser.set_defaults(budget="full")
