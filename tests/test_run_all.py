@@ -741,8 +741,8 @@ def test_baseline_searches_run_when_named_with_their_own_seeds_and_curves(tmp_pa
     assert '<a id="search_ppo_objects"></a>' not in report.read_text()
 
 
-@pytest.mark.parametrize("normalize", [False, True])
-def test_a_ppo_run_on_the_objects_with_attention(normalize, monkeypatch):
+@pytest.mark.parametrize("normalize, gamma", [(False, 0.9), (True, 0.9), (True, None)])
+def test_a_ppo_run_on_the_objects_with_attention(normalize, gamma, monkeypatch):
     from stable_baselines3.common import vec_env
     from benchmarks.reproduce.units import run_unit
 
@@ -756,14 +756,17 @@ def test_a_ppo_run_on_the_objects_with_attention(normalize, monkeypatch):
     monkeypatch.setattr(vec_env, "VecNormalize", Recorded)
     params = {**REGISTRY["search_ppo_objects"].params("CartPole, gamma 0.9, attention"),
               "hyperparams": {"n_envs": 2, "n_steps": 32, "batch_size": 32, "n_epochs": 1,
-                              "gamma": 0.9, "normalize": normalize},
+                              "normalize": normalize, **({} if gamma is None else
+                                                         {"gamma": gamma})},
               "step_scale": 1.0, "max_objects": 32}
     result = run_unit(params, TINY, 0, TINY.samples)
     assert params["attention"] and result["total_timesteps"] >= TINY.dqn_steps
     assert len(result["curve"]) == 4 and np.isfinite(result["reward"])
-    # rewards only, at the run's discount; never the padded observations
+    # rewards only, at the run's discount (PPO's own default, 0.99, if not set); never the
+    # padded observations
     assert [kwargs for kwargs, _ in wrapped] == (
-        [{"norm_obs": False, "norm_reward": True, "gamma": 0.9}] if normalize else [])
+        [{"norm_obs": False, "norm_reward": True, "gamma": gamma or 0.99}] if normalize
+        else [])
     # and the model trained through it: its return statistics saw every step
     assert all(env.ret_rms.count >= TINY.dqn_steps for _, env in wrapped)
 

@@ -2,6 +2,7 @@
 stable-baselines3 run, a reference policy's score (the planner's ceiling, the scripted
 heuristic, random play), or the attention figure's forest. Each returns a JSON-ready dict."""
 import dataclasses
+import inspect
 import time
 from functools import lru_cache
 
@@ -215,12 +216,12 @@ def _sb3(params, budget, seed, samples):
         hyperparams["policy_kwargs"] = {
             **hyperparams.get("policy_kwargs", {}), "features_extractor_class": SetEncoder,
             "features_extractor_kwargs": {"attention": params["attention"]}}
+    algo = {"DQN": DQN, "PPO": PPO}[params["algo"]]
     train_env = make_vec_env(lambda: wrap(_make_env(params)), n_envs=n_envs, seed=seed)
     if normalize:  # the evaluation plays the raw env and counts raw rewards
-        train_env = VecNormalize(train_env, norm_obs=False, norm_reward=True,
-                                 gamma=hyperparams.get("gamma", 0.99))
-    model = {"DQN": DQN, "PPO": PPO}[params["algo"]](
-        "MlpPolicy", train_env, seed=seed, device="cpu", **hyperparams)
+        gamma = hyperparams.get("gamma", inspect.signature(algo).parameters["gamma"].default)
+        train_env = VecNormalize(train_env, norm_obs=False, norm_reward=True, gamma=gamma)
+    model = algo("MlpPolicy", train_env, seed=seed, device="cpu", **hyperparams)
     model.set_logger(Logger(None, []))  # SB3's default logger makes a folder per run
     eval_env = _make_env(params)
     eval_wrapper = wrap(eval_env)    # pads or counts the evaluation's observations
