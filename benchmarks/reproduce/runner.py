@@ -49,8 +49,9 @@ class Unit:
             actions = 2.0 if p["env_id"] == "ObjectWorldSword-v0" else 1.0
             return (60.0 * actions ** 2 * budget.eval_steps / 20_000
                     if p["policy"] == "planner" else 1.0)
-        if p["kind"] in ("dqn", "sb3"):
-            objects = 4.0 if p.get("observation") == "objects" else 1.0
+        if p["kind"] in ("dqn", "sb3"):  # DQN's updates through the set encoder cost most
+            objects = 4.0 if p.get("observation") == "objects" and p.get("algo") != "PPO" \
+                else 1.0
             return (2.5e-3 * (budget.dqn_steps or budget.iterations * self.samples)
                     * p.get("step_scale", 1.0) * objects)
         trees = (p["n_estimators"] / 15 * (p["n_tests"] / 300) ** 0.5
