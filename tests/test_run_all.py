@@ -741,12 +741,26 @@ def test_baseline_searches_run_when_named_with_their_own_seeds_and_curves(tmp_pa
     assert '<a id="search_ppo_objects"></a>' not in report.read_text()
 
 
+@pytest.mark.parametrize("name", ["full", "quick"])
+def test_the_tuned_baselines_are_scored_once_per_fqi_iteration(name):
+    baselines, budget = REGISTRY["baselines"], BUDGETS[name]
+    own = [label for label, setting in baselines.settings.items() if "same_as" not in setting]
+    assert len(own) == 3
+    assert [baselines.params(label, budget)["checkpoints"] for label in own] == [
+        budget.iterations] * 3
+
+
 @pytest.mark.parametrize("normalize, gamma", [(False, 0.9), (True, 0.9), (True, None)])
 def test_a_ppo_run_on_the_objects_with_attention(normalize, gamma, monkeypatch):
+    import stable_baselines3
     from stable_baselines3.common import vec_env
     from benchmarks.reproduce.units import run_unit
 
     wrapped = []
+
+    class OtherDefault(stable_baselines3.PPO):  # a discount default of its own
+        def __init__(self, *args, gamma=0.95, **kwargs):
+            super().__init__(*args, gamma=gamma, **kwargs)
 
     class Recorded(vec_env.VecNormalize):
         def __init__(self, venv, **kwargs):
@@ -754,6 +768,7 @@ def test_a_ppo_run_on_the_objects_with_attention(normalize, gamma, monkeypatch):
             wrapped.append((kwargs, self))
 
     monkeypatch.setattr(vec_env, "VecNormalize", Recorded)
+    monkeypatch.setattr(stable_baselines3, "PPO", OtherDefault)
     params = {**REGISTRY["search_ppo_objects"].params("CartPole, gamma 0.9, attention"),
               "hyperparams": {"n_envs": 2, "n_steps": 32, "batch_size": 32, "n_epochs": 1,
                               "normalize": normalize, **({} if gamma is None else
@@ -762,10 +777,10 @@ def test_a_ppo_run_on_the_objects_with_attention(normalize, gamma, monkeypatch):
     result = run_unit(params, TINY, 0, TINY.samples)
     assert params["attention"] and result["total_timesteps"] >= TINY.dqn_steps
     assert len(result["curve"]) == 4 and np.isfinite(result["reward"])
-    # rewards only, at the run's discount (PPO's own default, 0.99, if not set); never the
+    # rewards only, at the run's discount (the algorithm's default if not set); never the
     # padded observations
     assert [kwargs for kwargs, _ in wrapped] == (
-        [{"norm_obs": False, "norm_reward": True, "gamma": gamma or 0.99}] if normalize
+        [{"norm_obs": False, "norm_reward": True, "gamma": gamma or 0.95}] if normalize
         else [])
     # and the model trained through it: its return statistics saw every step
     assert all(env.ret_rms.count >= TINY.dqn_steps for _, env in wrapped)

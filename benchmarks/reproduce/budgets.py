@@ -61,19 +61,21 @@ class Budget:
         return EVAL_REFERENCE_STEPS / self.eval_steps
 
 
+_QUICK_ITERATIONS = 4
 BUDGETS = {
     "full": Budget("full", seeds=5, iterations=20, samples=20_000, eval_steps=20_000,
                    rmse_samples=20_000, rmse_folds=10, attention_iterations=10),
-    # Two seeds (sd bands, noise-aware verdicts) of every experiment in about 10 min on 2
-    # cores (`make bench` runs two at a time). The tuned baselines take about a third of the
-    # run time (their steps follow the FQI run's), so they evaluate once per FQI iteration,
-    # as at the full budget. The treasure game's global view holds ~360 objects per state
-    # (local view ~40); with the thesis's M=30, K=500 its run cost 9x the local view's, so at
-    # this budget all four views get smaller forests.
-    "quick": Budget("quick", seeds=2, iterations=4, samples=2_000, eval_steps=8_000,
-                    rmse_samples=5_000, rmse_folds=3, attention_iterations=3,
+    # Two seeds (sd bands, noise-aware verdicts) of every experiment in about 7.5 min on 2
+    # cores (`make bench` runs two at a time; 10 min with its set-up). The tuned baselines'
+    # steps follow the FQI run's, and they evaluate once per FQI iteration, as at the full
+    # budget (evaluating 20 times, they took 9 of the 24 min that 5 x 4,000 samples took).
+    # The treasure game's global view holds ~360 objects per state (local view ~40); with
+    # the thesis's M=30, K=500 its run cost 9x the local view's, so at this budget all four
+    # views get smaller forests.
+    "quick": Budget("quick", seeds=2, iterations=_QUICK_ITERATIONS, samples=2_000,
+                    eval_steps=8_000, rmse_samples=5_000, rmse_folds=3, attention_iterations=3,
                     overrides={"treasure": {"n_estimators": 10, "n_tests": 200},
-                               "baselines": {"checkpoints": 4}}),
+                               "baselines": {"checkpoints": _QUICK_ITERATIONS}}),
     # for the tests: every experiment end to end in seconds
     "tiny": Budget("tiny", seeds=1, iterations=2, samples=200, eval_steps=50,
                    rmse_samples=200, rmse_folds=2, dqn_steps=100, attention_iterations=1,

@@ -12,7 +12,7 @@ from matplotlib.ticker import MaxNLocator, StrMethodFormatter  # noqa: E402
 
 import envs  # noqa: E402
 
-from .stats import LAST_WINDOW  # noqa: E402
+from .stats import last_window  # noqa: E402
 
 __all__ = ["plot_experiment", "TYPE_NAMES", "ACTION_NAMES"]
 
@@ -68,7 +68,7 @@ def _curves(experiment, stats, runs, budget):
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("reward per 20,000 greedy steps")
     ax.set_title(_title(experiment, budget, stats), fontsize=10)
-    ax.legend(fontsize=8, title=f"setting (mean of last {LAST_WINDOW} it.)",
+    ax.legend(fontsize=8, title=f"setting (mean of last {last_window(budget)} it.)",
               title_fontsize=8)
     ax.grid(alpha=0.3)
     return fig

@@ -8,7 +8,7 @@ from pathlib import Path
 from .plots import ACTION_NAMES, TYPE_NAMES, plot_experiment
 from .registry import EXPERIMENTS, REGISTRY
 from .runner import gather, setting_units
-from .stats import LAST_WINDOW
+from .stats import last_window
 
 __all__ = ["write_outputs", "figure_name"]
 
@@ -106,10 +106,11 @@ def _header(experiments, budget, seeds, elapsed, n_run):
         + "".join(f" At this budget `{name}` runs with "
                   + ", ".join(f"{key}={value}" for key, value in params.items())
                   + " (every setting alike)." for name, params in budget.overrides.items())
-        + f"\n\nScores: FQI = mean reward of the last {LAST_WINDOW} iterations (mean over "
-        f"runs, +- sd over runs); 'within noise' = the gap is under 2 standard errors of the "
-        f"averaged rewards. Verdicts are computed from these numbers by the rules in "
-        f"`benchmarks/reproduce/registry.py`.\n\n")
+        + f"\n\nScores: FQI = mean reward of the last {last_window(budget)} iterations (mean "
+        f"over runs, +- sd over runs); 'within noise' = the gap is under 2 standard errors of "
+        f"the averaged rewards. Verdicts are computed from these numbers by the rules in "
+        f"`benchmarks/reproduce/registry.py`. Times are each run's wall time as it ran, "
+        f"other runs perhaps sharing the cores (`--jobs 2`, as `make bench`).\n\n")
 
 
 def _summary_table(rows):

@@ -3,10 +3,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["SettingStats", "summarise", "LAST_WINDOW"]
+__all__ = ["SettingStats", "summarise", "LAST_WINDOW", "last_window"]
 
 # A run's score: its mean reward over the last iterations (the thesis's "converges to").
 LAST_WINDOW = 5
+
+
+def last_window(budget):
+    """How many iterations an FQI score averages at `budget`: the last `LAST_WINDOW`, or
+    every iteration of a shorter run."""
+    return min(LAST_WINDOW, budget.iterations)
 
 
 @dataclass
