@@ -353,8 +353,7 @@ class FQI:
         start = time.perf_counter()
         new = 0
         collect_reward = np.nan
-        if self._data is None or (self.resample_every is not None
-                                  and self.iteration % self.resample_every == 0):
+        if self._collects():
             try:
                 batch, n_steps = self._collector.collect(
                     self.samples_per_iteration, self._behaviour,
@@ -409,6 +408,11 @@ class FQI:
                   f"targets {record['t_targets']:5.2f}s  fit {record['t_fit']:5.2f}s  "
                   f"evaluate {record['t_evaluate']:5.2f}s")
         return record
+
+    def _collects(self):
+        """Whether the next iteration collects transitions."""
+        return self._data is None or (self.resample_every is not None
+                                      and self.iteration % self.resample_every == 0)
 
     def _behaviour(self, obs, q):
         """Collection policy: uniform random before the first fit (``q`` is None), then
@@ -563,8 +567,13 @@ class FQI:
         return agent
 
     def __getstate__(self):
+        """The agent's attributes for pickle, envs and random streams included, so an
+        unpickled agent learns on exactly as this one would; less the threads, and less the
+        transitions when the next iteration replaces them."""
         state = self.__dict__.copy()
         state["_pool"] = None  # threads do not pickle; a new pool starts on demand
+        if self._collects() and not self.keep_data:
+            state["_data"] = None
         return state
 
     def __repr__(self):

@@ -2,6 +2,7 @@
 thesis's numbers, learning, baselines, bad input. Other envs: test_fqi_envs.py."""
 import csv
 import os
+import pickle
 import tempfile
 
 import gymnasium as gym
@@ -135,6 +136,26 @@ def test_save_load_round_trip(trained, tmp_path):
     assert isinstance(loaded.get_env(), envs.BatchedObjectWorld)  # from the saved id
     loaded.learn(1)  # training continues on fresh data
     assert loaded.iteration == 3 and loaded.num_timesteps == 3000
+
+
+def _without_times(history):
+    return [{k: v for k, v in record.items() if not k.startswith("t_")} for record in history]
+
+
+@pytest.mark.parametrize("params", [{}, {"keep_data": True, "max_samples": 3000},
+                                    {"resample_every": 2}],
+                         ids=["re-sampling", "keeping data", "every 2"])
+def test_a_pickled_agent_learns_on_exactly_as_the_original(params):
+    agent = small_agent(**params).learn(1)
+    copy = pickle.loads(pickle.dumps(agent))
+    # the transitions travel only when the next iteration still uses them
+    assert (copy._data is None) == (not params)
+    agent.learn(2)
+    copy.learn(2)
+    assert _without_times(copy.history) == _without_times(agent.history)
+    worlds = envs.BatchedObjectWorld(50)
+    obs, _ = worlds.reset(seed=envs.reference_worlds(50))
+    np.testing.assert_array_equal(copy.q_values(obs), agent.q_values(obs))
 
 
 def test_same_seed_same_reward_curve():

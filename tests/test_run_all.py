@@ -16,8 +16,8 @@ from matplotlib.colors import to_rgb
 import envs
 from benchmarks.reproduce import BUDGETS, EXPERIMENTS, REGISTRY
 from benchmarks.reproduce import plots, runner
-from benchmarks.reproduce.cache import (attempts, load_unit, mark_attempt, save_unit, slug,
-                                        unit_path)
+from benchmarks.reproduce.cache import (Checkpoint, attempts, load_unit, mark_attempt,
+                                        save_unit, slug, unit_path)
 from benchmarks.reproduce.cli import main, parse_seeds
 from benchmarks.reproduce.findings import (AtLeast, Falls, Faster, HighestPeak, MoreStable,
                                            NearRandom, Ranking, Sign, Similar)
@@ -26,6 +26,7 @@ from benchmarks.reproduce.report import figure_name, write_outputs
 from benchmarks.reproduce.runner import MAX_ATTEMPTS, ClusterError, cluster, gather, plan, run
 from benchmarks.reproduce.stats import SettingStats, summarise
 from envs._render import _STYLE
+from fqi import FQI
 
 TINY = BUDGETS["tiny"]
 
@@ -333,10 +334,71 @@ def test_second_invocation_reuses_the_cache_and_resumes(tiny_run):
     assert units[2].path.exists() and units[0].path.stat().st_mtime_ns == before
 
 
+def _without_times(result):
+    return {**result, "seconds": None,
+            "history": [{k: v for k, v in r.items() if not k.startswith("t_")}
+                        for r in result["history"]]}
+
+
+def test_an_interrupted_fqi_run_resumes_from_its_last_iteration_to_the_same_result(
+        tmp_path, monkeypatch):
+    monkeypatch.setattr(Checkpoint, "interval", 0.0)  # a save after every iteration
+    budget = replace(TINY, iterations=3)
+    uninterrupted, resumed = (plan([REGISTRY["treasure"]], budget, tmp_path / name,
+                                   seeds=[0])[3] for name in ("once", "twice"))
+    assert resumed.label == "global"
+    run([uninterrupted], budget, progress=False)
+    iterate = FQI._iterate
+
+    def stop_at_the_third(agent):
+        if agent.iteration == 2:
+            raise KeyboardInterrupt
+        return iterate(agent)
+
+    monkeypatch.setattr(FQI, "_iterate", stop_at_the_third)
+    with pytest.raises(KeyboardInterrupt):
+        run([resumed], budget, progress=False)
+    checkpoint = Checkpoint(resumed.path, resumed.params, budget, resumed.samples, 0)
+    assert checkpoint.load()["agent"].iteration == 2 and attempts(resumed.path) == 0
+    resumed_iterations = []
+    monkeypatch.setattr(FQI, "_iterate",
+                        lambda agent: resumed_iterations.append(agent.iteration)
+                        or iterate(agent))
+    run([resumed], budget, progress=False)
+    assert resumed_iterations == [2]  # only the missing iteration ran
+    assert not checkpoint.path.exists()  # gone with the finished result
+    first, second = (load_unit(u.path, u.params, budget, u.samples, 0)["result"]
+                     for u in (uninterrupted, resumed))
+    assert _without_times(second) == _without_times(first)
+
+
+def test_a_checkpoint_serves_only_its_own_unit(tmp_path, capsys):
+    params = REGISTRY["sampling"].params("normal", TINY)
+    path = unit_path(tmp_path, TINY, "sampling", "normal", 0)
+    checkpoint = Checkpoint(path, params, TINY, 200, 0)
+    assert checkpoint.load() is None
+    assert not checkpoint.save({"iteration": 1})  # not yet `interval` seconds
+    assert not path.parent.exists()
+    checkpoint.interval = 0.0
+    assert checkpoint.save({"iteration": 1})
+    assert checkpoint.load() == {"iteration": 1}
+    assert sorted(p.name for p in path.parent.iterdir()) == ["seed0.json.partial"]
+    for other in (Checkpoint(path, {**params, "n_tests": 51}, TINY, 200, 0),
+                  Checkpoint(path, params, TINY, 400, 0),
+                  Checkpoint(path, params, replace(TINY, iterations=3), 200, 0),
+                  Checkpoint(path, params, TINY, 200, 1)):
+        assert other.load() is None
+    checkpoint.path.write_bytes(b"truncated")
+    assert checkpoint.load() is None
+    assert f"ignoring {checkpoint.path}: not a readable checkpoint (" in capsys.readouterr().err
+    save_unit(path, params, TINY, 200, "sampling", "normal", 0, _FQI_RESULT)
+    assert not checkpoint.path.exists()
+
+
 def test_units_run_seed_major_and_longest_first_within_a_seed(tmp_path, monkeypatch):
     order = []
 
-    def record(params, budget, seed, samples):
+    def record(params, budget, seed, samples, checkpoint):
         order.append((seed, next(u for u in units if u.params == params
                                  and u.seed == seed).cost(budget)))
         return dict(_FQI_RESULT)

@@ -6,18 +6,22 @@ registry entry or budget re-runs the unit instead of mixing results; a file that
 run record at all (damaged, or edited by hand) counts as missing too, and says so. Beside it,
 ``seed<k>.json.attempts`` counts starts that never finished (the interpreter crashed or was
 killed, or the cluster worker running it died), so the runner can try such units last and
-eventually give up on them.
+eventually give up on them. An FQI run also leaves ``seed<k>.json.partial`` while it runs,
+its state after its last finished iteration (`Checkpoint`), and resumes from it.
 """
 import json
 import os
 import re
 import sys
 import tempfile
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import joblib
+
 __all__ = ["unit_path", "load_unit", "save_unit", "slug", "attempts", "mark_attempt",
-           "set_attempts"]
+           "set_attempts", "Checkpoint"]
 
 
 def slug(label):
@@ -131,11 +135,11 @@ def _misfit(value, shape, where=""):
 _IGNORED = set()  # files already reported by `_ignore` in this process
 
 
-def _ignore(path, problem):
-    """Say (once per file) that the file at `path` is no run record and counts as missing."""
+def _ignore(path, problem, what="a run record"):
+    """Say (once per file) that the file at `path` is not `what` and counts as missing."""
     if path not in _IGNORED:
         _IGNORED.add(path)
-        print(f"ignoring {path}: not a run record ({problem}); it counts as missing",
+        print(f"ignoring {path}: not {what} ({problem}); it counts as missing",
               file=sys.stderr)
 
 
@@ -199,18 +203,81 @@ def save_unit(path, params, budget, samples, experiment, label, seed, result):
         JSON-ready output of `reproduce.units.run_unit`.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     record = {"experiment": experiment, "setting": label, "seed": seed,
               **_record_key(params, budget, samples), "result": result}
+    _write_atomically(path, lambda f: json.dump(record, f, indent=1, allow_nan=True), "w")
+    _attempts_path(path).unlink(missing_ok=True)
+    _checkpoint_path(path).unlink(missing_ok=True)
+
+
+def _write_atomically(path, write, mode):
+    """Call ``write(f)`` on a temporary file beside `path` (opened with `mode`), then rename
+    it to `path`: readers see the old file or the whole new one, never a part."""
+    path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w") as f:
-            json.dump(record, f, indent=1, allow_nan=True)
+        with os.fdopen(fd, mode) as f:
+            write(f)
         os.replace(tmp, path)
-        _attempts_path(path).unlink(missing_ok=True)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _checkpoint_path(path):
+    return Path(f"{path}.partial")
+
+
+class Checkpoint:
+    """The saved state of an unfinished unit: ``<result path>.partial``, a compressed joblib
+    pickle, kept until `save_unit` writes the unit's result.
+
+    It holds the unit's record key (parameters, samples, budget fields) and seed, and is
+    used only by the unit they describe: one of other parameters counts as missing, and is
+    replaced at the next save. Loading unpickles the file: keep the cache trusted. Saves
+    come at most every `interval` seconds (the first one `interval` after construction), so
+    short runs spend nothing on them.
+
+    Parameters
+    ----------
+    path : path-like
+        The unit's result path (`unit_path`).
+    params, budget, samples, seed
+        As for `load_unit`.
+    """
+
+    interval = 60.0
+
+    def __init__(self, path, params, budget, samples, seed):
+        self.path = _checkpoint_path(path)
+        self._key = {**_record_key(params, budget, samples), "seed": seed}
+        self._saved = time.monotonic()
+
+    def load(self):
+        """The state last saved for this unit, or None: none saved, one of another unit, or
+        a file that cannot be read (said on stderr)."""
+        try:
+            with open(self.path, "rb") as f:
+                saved = joblib.load(f)
+        except FileNotFoundError:
+            return None
+        except Exception as exc:  # unpickling damaged data can raise almost anything
+            _ignore(self.path, f"{type(exc).__name__}: {exc}", "a readable checkpoint")
+            return None
+        if not isinstance(saved, dict) or set(saved) != {"key", "state"}:
+            _ignore(self.path, "another kind of pickle", "a checkpoint")
+            return None
+        return saved["state"] if saved["key"] == self._key else None
+
+    def save(self, state):
+        """Replace the saved state by `state` (any picklable object), atomically, if the last
+        save is `interval` seconds old; returns whether it saved."""
+        if time.monotonic() - self._saved < self.interval:
+            return False
+        saved = {"key": self._key, "state": state}
+        _write_atomically(self.path, lambda f: joblib.dump(saved, f, compress=3), "wb")
+        self._saved = time.monotonic()
+        return True
 
 
 def _attempts_path(path):

@@ -18,7 +18,8 @@ import envs
 import fqi
 
 from . import units as _units
-from .cache import attempts, load_unit, mark_attempt, save_unit, set_attempts, unit_path
+from .cache import (Checkpoint, attempts, load_unit, mark_attempt, save_unit, set_attempts,
+                    unit_path)
 from .registry import resolve
 from .stats import summarise
 from .units import run_unit
@@ -122,7 +123,8 @@ def setting_units(experiment, label, budget, out, seeds=None):
 
 def _execute(unit, budget):
     mark_attempt(unit.path)
-    result = run_unit(unit.params, budget, unit.seed, unit.samples)
+    result = run_unit(unit.params, budget, unit.seed, unit.samples,
+                      Checkpoint(unit.path, unit.params, budget, unit.samples, unit.seed))
     _save(unit, budget, result)
     return unit, result["seconds"]
 
@@ -147,7 +149,9 @@ def run(units, budget, jobs=1, progress=True, client=None):
     A unit's start counts as a crash until the unit finishes; an interrupt (Ctrl-C) takes
     the count back, so only crashes get a unit skipped (after `MAX_ATTEMPTS` of them). On a
     cluster, each worker that died running a unit is one crash of it; the unit is then
-    retried after the others, or skipped.
+    retried after the others, or skipped. Run here, an FQI run saves its state after its
+    iterations (`cache.Checkpoint`, at most once a minute) and a restart resumes it from
+    there, to the same result; on a cluster it starts over.
 
     Parameters
     ----------

@@ -27,7 +27,7 @@ _TOP_TESTS = 4  # boxes drawn per action and object type in the attention figure
 _ATTENTION_CANDIDATES = 40  # reference worlds searched for a busy view to draw on
 
 
-def run_unit(params, budget, seed, samples):
+def run_unit(params, budget, seed, samples, checkpoint=None):
     """Run one unit.
 
     Parameters
@@ -38,20 +38,25 @@ def run_unit(params, budget, seed, samples):
     seed : int
     samples : int
         Samples per FQI iteration (the budget's, scaled by the experiment).
+    checkpoint : reproduce.cache.Checkpoint, default=None
+        An FQI run saves its state there after its iterations (at most every
+        ``checkpoint.interval`` seconds) and resumes from what it finds there, to the result
+        it would have had uninterrupted. Other kinds ignore it.
 
     Returns
     -------
     result : dict
-        JSON-ready; always has ``seconds``.
+        JSON-ready; always has ``seconds`` (a resumed run's: of all its parts).
     """
     start = time.perf_counter()
     runner = {"fqi": _fqi, "rmse": _rmse, "dqn": _dqn, "sb3": _sb3, "policy": _policy,
               "attention": _attention}
+    resumable = {"checkpoint": checkpoint} if params["kind"] == "fqi" else {}
     # One BLAS thread: the forests bring their own threads, and on 2 shared cores the
     # ridge fit of the grid baseline ran 10x slower with OpenBLAS's 2 threads (measured).
     with threadpool_limits(1, user_api="blas"):
-        result = runner[params["kind"]](params, budget, seed, samples)
-    result["seconds"] = time.perf_counter() - start
+        result = runner[params["kind"]](params, budget, seed, samples, **resumable)
+    result["seconds"] = result.pop("earlier_seconds", 0.0) + time.perf_counter() - start
     return result
 
 
@@ -114,9 +119,23 @@ def make_agent(params, budget, seed, samples):
                n_envs=min(400, samples), eval_seeds=_reference_seeds(env, budget), seed=seed)
 
 
-def _fqi(params, budget, seed, samples):
-    """Rewards per iteration (per 20,000 evaluation steps) and the random policy's."""
-    agent = make_agent(params, budget, seed, samples).learn(budget.iterations)
+def _fqi(params, budget, seed, samples, checkpoint=None):
+    """Rewards per iteration (per 20,000 evaluation steps) and the random policy's; with a
+    `checkpoint`, the pickled agent (its envs and random streams) after an iteration but the
+    last, which a later call resumes."""
+    start = time.perf_counter()
+    saved = None if checkpoint is None else checkpoint.load()
+    agent, earlier = ((saved["agent"], saved["seconds"]) if saved is not None
+                      else (make_agent(params, budget, seed, samples), 0.0))
+
+    def save(locals_, globals_):
+        if agent.iteration < budget.iterations:
+            checkpoint.save({"agent": agent,
+                             "seconds": earlier + time.perf_counter() - start})
+
+    if agent.iteration < budget.iterations:
+        agent.learn(budget.iterations - agent.iteration,
+                    callback=None if checkpoint is None else save)
     scale = budget.reward_scale
     env = _make_env(params)
     random_reward = evaluate(RandomPolicy(env, seed=seed), env,
@@ -124,7 +143,8 @@ def _fqi(params, budget, seed, samples):
     keys = ("n_samples", "nodes_per_tree", "t_collect", "t_fit", "t_evaluate", "t_total")
     return {"rewards": [r["reward"] * scale for r in agent.history],
             "random_reward": random_reward * scale,
-            "history": [{k: r[k] for k in keys} for r in agent.history]}
+            "history": [{k: r[k] for k in keys} for r in agent.history],
+            "earlier_seconds": earlier}
 
 
 @lru_cache(maxsize=4)
