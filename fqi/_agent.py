@@ -567,9 +567,10 @@ class FQI:
         return agent
 
     def __getstate__(self):
-        """The agent's attributes for pickle, envs and random streams included, so an
-        unpickled agent learns on exactly as this one would; less the threads, and less the
-        transitions when the next iteration replaces them."""
+        """The agent's attributes for pickle: with its envs (an env that does not pickle
+        makes the agent unpicklable) and random streams, so an unpickled agent learns on
+        exactly as this one would; less the threads, and less the transitions when the next
+        iteration replaces them. A ``log_path`` travels too: a copy appends to its CSV."""
         state = self.__dict__.copy()
         state["_pool"] = None  # threads do not pickle; a new pool starts on demand
         if self._collects() and not self.keep_data:

@@ -6,6 +6,7 @@ Rollouts talk to gymnasium's vector API only, so a registered ``vector_entry_poi
 batched engine) is the fast path and every other env runs in a `SyncVectorEnv`.
 """
 import copy
+from functools import partial
 
 import gymnasium as gym
 from gymnasium import spaces
@@ -45,8 +46,8 @@ def _make_vector(env, n_envs):
         if _rebuildable(spec):
             mode = "sync" if spec.additional_wrappers else None
             return gym.make_vec(spec, num_envs=n_envs, vectorization_mode=mode)
-        return SyncVectorEnv([lambda: _deepcopy(env)] * n_envs)
-    return SyncVectorEnv([lambda: _called(env)] * n_envs)
+        return SyncVectorEnv([partial(_deepcopy, env)] * n_envs)
+    return SyncVectorEnv([partial(_called, env)] * n_envs)
 
 
 def _rebuildable(spec):

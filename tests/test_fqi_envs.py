@@ -3,6 +3,7 @@ form, vector envs with episodes of different lengths under each autoreset mode, 
 callbacks, persistence, evaluation, bad envs, and the package's import rules."""
 import ast
 import pathlib
+import pickle
 import subprocess
 import sys
 
@@ -252,6 +253,17 @@ def test_every_env_form():
     doubled = FQI(classic_forest(), forms["wrapped env"][0], samples_per_iteration=64,
                   eval_episodes=0, seed=0).learn(1)
     assert set(np.unique(doubled._data.rewards)) == {2.0}  # the wrapper is kept
+
+
+@pytest.mark.parametrize("env", [Countdown(), Countdown], ids=["env made by hand", "factory"])
+def test_an_agent_on_copies_or_a_factory_pickles_and_learns_on_the_same(env):
+    agent = FQI(classic_forest(random_state=0), env, samples_per_iteration=60,
+                eval_episodes=2, seed=0).learn(1)
+    copy = pickle.loads(pickle.dumps(agent))
+    agent.learn(2)
+    copy.learn(2)
+    assert [r["reward"] for r in copy.history] == [r["reward"] for r in agent.history]
+    assert copy.num_timesteps == agent.num_timesteps
 
 
 def test_a_given_vector_env_is_used_as_it_is():

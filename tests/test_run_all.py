@@ -358,7 +358,8 @@ def test_an_interrupted_fqi_run_resumes_from_its_last_iteration_to_the_same_resu
     monkeypatch.setattr(FQI, "_iterate", stop_at_the_third)
     with pytest.raises(KeyboardInterrupt):
         run([resumed], budget, progress=False)
-    checkpoint = Checkpoint(resumed.path, resumed.params, budget, resumed.samples, 0)
+    checkpoint = Checkpoint(resumed.path, resumed.params, budget, resumed.samples, 0,
+                            runner._environment())
     assert checkpoint.load()["agent"].iteration == 2 and attempts(resumed.path) == 0
     resumed_iterations = []
     monkeypatch.setattr(FQI, "_iterate",
@@ -372,10 +373,11 @@ def test_an_interrupted_fqi_run_resumes_from_its_last_iteration_to_the_same_resu
     assert _without_times(second) == _without_times(first)
 
 
-def test_a_checkpoint_serves_only_its_own_unit(tmp_path, capsys):
+def test_a_checkpoint_serves_only_its_own_unit_and_code(tmp_path, capsys):
     params = REGISTRY["sampling"].params("normal", TINY)
     path = unit_path(tmp_path, TINY, "sampling", "normal", 0)
-    checkpoint = Checkpoint(path, params, TINY, 200, 0)
+    code = {"project sources": "abc"}
+    checkpoint = Checkpoint(path, params, TINY, 200, 0, code)
     assert checkpoint.load() is None
     assert not checkpoint.save({"iteration": 1})  # not yet `interval` seconds
     assert not path.parent.exists()
@@ -383,16 +385,36 @@ def test_a_checkpoint_serves_only_its_own_unit(tmp_path, capsys):
     assert checkpoint.save({"iteration": 1})
     assert checkpoint.load() == {"iteration": 1}
     assert sorted(p.name for p in path.parent.iterdir()) == ["seed0.json.partial"]
-    for other in (Checkpoint(path, {**params, "n_tests": 51}, TINY, 200, 0),
-                  Checkpoint(path, params, TINY, 400, 0),
-                  Checkpoint(path, params, replace(TINY, iterations=3), 200, 0),
-                  Checkpoint(path, params, TINY, 200, 1)):
+    for other in (Checkpoint(path, {**params, "n_tests": 51}, TINY, 200, 0, code),
+                  Checkpoint(path, params, TINY, 400, 0, code),
+                  Checkpoint(path, params, replace(TINY, iterations=3), 200, 0, code),
+                  Checkpoint(path, params, TINY, 200, 1, code),
+                  Checkpoint(path, params, TINY, 200, 0, {"project sources": "abd"})):
         assert other.load() is None
     checkpoint.path.write_bytes(b"truncated")
     assert checkpoint.load() is None
     assert f"ignoring {checkpoint.path}: not a readable checkpoint (" in capsys.readouterr().err
     save_unit(path, params, TINY, 200, "sampling", "normal", 0, _FQI_RESULT)
     assert not checkpoint.path.exists()
+
+
+def test_a_start_that_saved_progress_is_no_crash_and_a_failed_save_no_failure(tmp_path,
+                                                                              capsys):
+    params = REGISTRY["sampling"].params("normal", TINY)
+    path = unit_path(tmp_path, TINY, "sampling", "normal", 0)
+    mark_attempt(path)  # a start that crashed without saving anything
+    checkpoint = Checkpoint(path, params, TINY, 200, 0, {})
+    checkpoint.interval = 0.0
+    mark_attempt(path)  # this start
+    assert attempts(path) == 2
+    assert checkpoint.save({"iteration": 1}) and attempts(path) == 1
+    checkpoint.path.unlink()
+    checkpoint.path.mkdir()  # nothing can replace a folder: every save fails
+    assert not checkpoint.save({"iteration": 2}) and not checkpoint.save({"iteration": 3})
+    err = capsys.readouterr().err
+    assert err.count(f"could not save the checkpoint {checkpoint.path} (") == 1
+    assert "the run goes on without" in err
+    assert [p.name for p in path.parent.iterdir() if p.name.endswith(".tmp")] == []
 
 
 def test_units_run_seed_major_and_longest_first_within_a_seed(tmp_path, monkeypatch):
@@ -767,7 +789,8 @@ def test_a_worker_that_dies_is_a_crash_of_its_unit(dask_client, tmp_path, capsys
     assert [line for line in capsys.readouterr().err.splitlines() if name in line] == [
         f"{name}: the worker running it died (2 crash(es); 3 skip it)",
         f"{name}: the worker running it died (3 crash(es); 3 skip it)",
-        f"skipping {name}: it crashed 3 times (delete {mixed.path}.attempts to retry)"]
+        f"skipping {name}: it crashed 3 times (delete {mixed.path}.attempts to retry, and "
+        f"its .partial, if any, to start over)"]
 
 
 def test_bench_fqi_and_sweep_fqi_runs_are_registry_settings():

@@ -6,8 +6,8 @@ registry entry or budget re-runs the unit instead of mixing results; a file that
 run record at all (damaged, or edited by hand) counts as missing too, and says so. Beside it,
 ``seed<k>.json.attempts`` counts starts that never finished (the interpreter crashed or was
 killed, or the cluster worker running it died), so the runner can try such units last and
-eventually give up on them. An FQI run also leaves ``seed<k>.json.partial`` while it runs,
-its state after its last finished iteration (`Checkpoint`), and resumes from it.
+eventually give up on them. A long FQI run also leaves ``seed<k>.json.partial`` while it
+runs, its state after the last iteration it saved (`Checkpoint`), and resumes from it.
 """
 import json
 import os
@@ -232,11 +232,14 @@ class Checkpoint:
     """The saved state of an unfinished unit: ``<result path>.partial``, a compressed joblib
     pickle, kept until `save_unit` writes the unit's result.
 
-    It holds the unit's record key (parameters, samples, budget fields) and seed, and is
-    used only by the unit they describe: one of other parameters counts as missing, and is
-    replaced at the next save. Loading unpickles the file: keep the cache trusted. Saves
-    come at most every `interval` seconds (the first one `interval` after construction), so
-    short runs spend nothing on them.
+    It holds the unit's record key (parameters, samples, budget fields), its seed and the
+    `code` that saved it, and serves only that unit run by that code: any other counts as
+    missing, and is replaced at the next save. Loading unpickles the file: keep the cache
+    trusted. Saves come at most every `interval` seconds (the first one `interval` after
+    construction), so short runs spend nothing on them. A start that saved its progress
+    is no crash: a save sets the unit's count of unfinished starts back to what it was when
+    the checkpoint was made. A save that fails (a full disk, say) is said once on stderr,
+    and the run goes on without it.
 
     Parameters
     ----------
@@ -244,18 +247,24 @@ class Checkpoint:
         The unit's result path (`unit_path`).
     params, budget, samples, seed
         As for `load_unit`.
+    code : dict
+        What else the state depends on: library versions and a digest of the project's
+        sources (`runner._environment`).
     """
 
     interval = 60.0
 
-    def __init__(self, path, params, budget, samples, seed):
+    def __init__(self, path, params, budget, samples, seed, code):
+        self._result = Path(path)
         self.path = _checkpoint_path(path)
-        self._key = {**_record_key(params, budget, samples), "seed": seed}
+        self._key = {**_record_key(params, budget, samples), "seed": seed, "code": code}
+        self._attempts = attempts(path)
         self._saved = time.monotonic()
+        self._failed = False
 
     def load(self):
-        """The state last saved for this unit, or None: none saved, one of another unit, or
-        a file that cannot be read (said on stderr)."""
+        """The state last saved for this unit by this code, or None: none saved, one of
+        another unit or code, or a file that cannot be read (said on stderr)."""
         try:
             with open(self.path, "rb") as f:
                 saved = joblib.load(f)
@@ -275,8 +284,17 @@ class Checkpoint:
         if time.monotonic() - self._saved < self.interval:
             return False
         saved = {"key": self._key, "state": state}
-        _write_atomically(self.path, lambda f: joblib.dump(saved, f, compress=3), "wb")
+        try:
+            _write_atomically(self.path, lambda f: joblib.dump(saved, f, compress=3), "wb")
+        except Exception as exc:  # the checkpoint is a convenience: the run goes on
+            if not self._failed:
+                self._failed = True
+                print(f"could not save the checkpoint {self.path} "
+                      f"({type(exc).__name__}: {exc}); the run goes on without",
+                      file=sys.stderr)
+            return False
         self._saved = time.monotonic()
+        set_attempts(self._result, self._attempts)
         return True
 
 

@@ -122,9 +122,10 @@ def setting_units(experiment, label, budget, out, seeds=None):
 
 
 def _execute(unit, budget):
+    checkpoint = Checkpoint(unit.path, unit.params, budget, unit.samples, unit.seed,
+                            _environment())
     mark_attempt(unit.path)
-    result = run_unit(unit.params, budget, unit.seed, unit.samples,
-                      Checkpoint(unit.path, unit.params, budget, unit.samples, unit.seed))
+    result = run_unit(unit.params, budget, unit.seed, unit.samples, checkpoint)
     _save(unit, budget, result)
     return unit, result["seconds"]
 
@@ -140,7 +141,8 @@ def _name(unit):
 
 def _say_skipped(unit, crashes):
     tqdm.write(f"skipping {_name(unit)}: it crashed {crashes} times (delete "
-               f"{unit.path}.attempts to retry)", file=sys.stderr)
+               f"{unit.path}.attempts to retry, and its .partial, if any, to start over)",
+               file=sys.stderr)
 
 
 def run(units, budget, jobs=1, progress=True, client=None):
