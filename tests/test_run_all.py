@@ -197,6 +197,9 @@ def test_cache_round_trip_and_mismatch(tmp_path):
     save_unit(path, params, TINY, 200, "fqi_K", "K=50", 0, _FQI_RESULT)
     assert load_unit(path, params, TINY, 200, 0)["result"]["rewards"] == [1.0, 2.0]
     assert list(path.parent.iterdir()) == [path]  # no temporary file left behind
+    umask = os.umask(0)
+    os.umask(umask)
+    assert path.stat().st_mode & 0o777 == 0o666 & ~umask  # readable as any file, not 0600
     assert load_unit(path, {**params, "n_tests": 51}, TINY, 200, 0) is None  # other params
     assert load_unit(path, params, TINY, 400, 0) is None  # other samples per iteration
     assert load_unit(path, params, replace(TINY, iterations=3), 200, 0) is None

@@ -13,8 +13,8 @@ import json
 import os
 import re
 import sys
-import tempfile
 import time
+import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -212,11 +212,12 @@ def save_unit(path, params, budget, samples, experiment, label, seed, result):
 
 def _write_atomically(path, write, mode):
     """Call ``write(f)`` on a temporary file beside `path` (opened with `mode`), then rename
-    it to `path`: readers see the old file or the whole new one, never a part."""
+    it to `path`: readers see the old file or the whole new one, never a part. The file
+    gets the permissions of any new file (the umask's), not `tempfile`'s owner-only ones."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
     try:
-        with os.fdopen(fd, mode) as f:
+        with open(tmp, mode.replace("w", "x")) as f:
             write(f)
         os.replace(tmp, path)
     except BaseException:
