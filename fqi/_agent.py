@@ -16,9 +16,9 @@ from ._callbacks import _as_callback
 from ._checks import (_check_bool, _check_int, _check_n_jobs, _check_real, _check_seed,
                       _check_verbose)
 from ._collect import _checked_step, _Collector, _Transitions
-from ._envs import _check_env, _copy_vector, _make_vector, _n_actions
+from ._envs import _check_env, _close_built, _copy_vector, _make_vector, _n_actions
 from ._evaluate import _eval_seeds, evaluate
-from ._logger import CSVLogger
+from ._logger import CSVLogger, _KeyValueLogger
 from ._observations import _ObjectRows, _observation_format
 from ._saving import _read_save, _write_save
 
@@ -26,8 +26,9 @@ __all__ = ["FQI"]
 
 _DEFAULT_ENVS = 16
 # What `save` leaves out (SB3 saves its __dict__ minus such a list): the envs, which hold
-# simulators, the transitions, the threads and the open log.
-_UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_pool", "_data", "logger"})
+# simulators, the transitions, the threads and the logs.
+_UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_pool", "_data", "_csv_log",
+                      "_logger"})
 # What a save holds beyond the constructor parameters.
 _LEARNED = ("q_functions_", "history", "num_timesteps", "iteration", "observation_space",
             "action_space")
@@ -79,8 +80,8 @@ class FQI:
         once per env; a vector env is used as it is. The env is tried once here (a reset
         and a step): an env that raises gives a RuntimeError naming the call.
     gamma : float, default=0.5
-        Discount factor in ``[0, 1)``. 0.5 scored best on ObjectWorld (README, "fqi");
-        control tasks with long horizons need more (0.99 on CartPole).
+        Discount factor in ``[0, 1)``. 0.5 scored best on ObjectWorld (``docs/fqi.md``,
+        "Discount factor"); control tasks with long horizons need more (0.99 on CartPole).
     epsilon : float, default=0.2
         Probability of a uniform random action while collecting (thesis: 0.2).
     samples_per_iteration : int, default=20_000
@@ -144,6 +145,9 @@ class FQI:
     observation_space, action_space : gymnasium.spaces.Space
         Of one env.
     n_actions : int
+        Number of actions (``action_space.n``): one Q-function each.
+    logger : object
+        The key-value logger of stable-baselines3 callbacks; see `FQI.logger`.
 
     Examples
     --------
@@ -172,6 +176,7 @@ class FQI:
         self.history = []
         self.num_timesteps = 0
         self.iteration = 0
+        self._logger = None
         self.set_env(env)
 
     @classmethod
@@ -212,7 +217,7 @@ class FQI:
         self.seed = _check_seed("seed", params["seed"])
         self.verbose = _check_verbose(params["verbose"])
         self.log_path = params["log_path"]
-        self.logger = None if self.log_path is None else CSVLogger(self.log_path)
+        self._csv_log = None if self.log_path is None else CSVLogger(self.log_path)
         self._pool = None
 
     # ------------------------------------------------------------------ envs
@@ -222,7 +227,8 @@ class FQI:
         Builds the training vector env and the evaluation one (from `eval_env`, else from
         the constructor's `eval_env`, else from `env`), then tries the env (a reset and a
         step) and the regressor (fitted on those observations). Collection starts new
-        episodes.
+        episodes. The vector envs the agent built for its previous env are closed (a vector
+        env given as it is stays open: it is the caller's).
 
         Parameters
         ----------
@@ -235,22 +241,32 @@ class FQI:
         else:
             _check_env(eval_env, "eval_env")
         vector = _make_vector(env, self.n_envs or _DEFAULT_ENVS)
-        if isinstance(env, VectorEnv) and self.n_envs not in (None, vector.num_envs):
-            raise ValueError(f"n_envs={self.n_envs} but the vector env has {vector.num_envs} "
-                             f"envs; leave n_envs out (None) for a vector env")
-        observation_space = vector.single_observation_space
-        action_space = vector.single_action_space
-        n_actions = _n_actions(action_space)
-        observations = _observation_format(observation_space)
-        if self.observation_space is not None and (observation_space, action_space) != (
-                self.observation_space, self.action_space):
-            raise ValueError(f"env has the spaces {observation_space} and {action_space}; "
-                             f"the agent was made for {self.observation_space} and "
-                             f"{self.action_space}")
-        eval_vector = self._evaluation_env(env, eval_env, vector,
-                                           (observation_space, action_space))
-        first = _tried(vector, observations)
-        self._check_regressor(observations, first)
+        eval_vector = None
+        try:
+            if isinstance(env, VectorEnv) and self.n_envs not in (None, vector.num_envs):
+                raise ValueError(f"n_envs={self.n_envs} but the vector env has "
+                                 f"{vector.num_envs} envs; leave n_envs out (None) for a "
+                                 f"vector env")
+            observation_space = vector.single_observation_space
+            action_space = vector.single_action_space
+            n_actions = _n_actions(action_space)
+            observations = _observation_format(observation_space)
+            if self.observation_space is not None and (observation_space, action_space) != (
+                    self.observation_space, self.action_space):
+                raise ValueError(f"env has the spaces {observation_space} and {action_space}; "
+                                 f"the agent was made for {self.observation_space} and "
+                                 f"{self.action_space}")
+            eval_vector = self._evaluation_env(env, eval_env, vector,
+                                               (observation_space, action_space))
+            first = _tried(vector, observations)
+            self._check_regressor(observations, first)
+        except BaseException:
+            _close_built(vector, env)
+            _close_built(eval_vector, eval_env)
+            raise
+        if getattr(self, "_env", None) is not None:  # not at construction
+            _close_built(self._env, self.env)
+            _close_built(self._eval_env, self.eval_env)
         self.env, self.eval_env = env, eval_env
         self._env, self._eval_env = vector, eval_vector
         self.observation_space, self.action_space = observation_space, action_space
@@ -267,6 +283,7 @@ class FQI:
             evaluation = _make_vector(eval_env, n)
             found = (evaluation.single_observation_space, evaluation.single_action_space)
             if found != spaces:
+                _close_built(evaluation, eval_env)
                 raise ValueError(f"eval_env has the spaces {found[0]} and {found[1]}; env "
                                  f"has {spaces[0]} and {spaces[1]}")
             return evaluation
@@ -303,6 +320,39 @@ class FQI:
     def get_env(self):
         """The training vector env (None for an agent loaded without an env)."""
         return self._env
+
+    def get_vec_normalize_env(self):
+        """None: FQI normalizes no observations (stable-baselines3's callbacks ask)."""
+        return None
+
+    @property
+    def logger(self):
+        """The key-value logger that stable-baselines3 callbacks write to
+        (``self.logger.record`` in a callback). Each iteration records its `history`
+        record in it, every key prefixed with ``fqi/``, and dumps it at `num_timesteps`.
+        By default it keeps the values in memory until that dump and writes them nowhere;
+        `set_logger` gives it a stable-baselines3 ``Logger`` to write to.
+        """
+        if self._logger is None:
+            self._logger = _KeyValueLogger()
+        return self._logger
+
+    def set_logger(self, logger):
+        """Log to `logger` from now on, as stable-baselines3's ``set_logger``.
+
+        Parameters
+        ----------
+        logger : stable_baselines3.common.logger.Logger
+            Or any object with its ``record(key, value)`` and ``dump(step)`` methods; for
+            example ``stable_baselines3.common.logger.configure(folder, ["stdout", "csv",
+            "tensorboard"])``. Not saved or pickled with the agent.
+        """
+        for method in ("record", "dump"):
+            if not callable(getattr(logger, method, None)):
+                raise TypeError(f"logger must have record and dump methods, as a "
+                                f"stable-baselines3 Logger; {type(logger).__name__} has no "
+                                f"{method}")
+        self._logger = logger
 
     # ------------------------------------------------------------------ training
     def learn(self, n_iterations, callback=None, progress_bar=False):
@@ -400,8 +450,11 @@ class FQI:
         }
         self.history.append(record)
         self.iteration += 1
-        if self.logger is not None:
-            self.logger.write(record)
+        if self._csv_log is not None:
+            self._csv_log.write(record)
+        for key, value in record.items():
+            self.logger.record(f"fqi/{key}", value)
+        self.logger.dump(step=self.num_timesteps)
         if self.verbose:
             print(f"iteration {record['iteration']:3d}  reward {record['reward']:>12,.0f}  "
                   f"samples {len(data):>7,d}  collect {record['t_collect']:5.2f}s  "
@@ -560,7 +613,7 @@ class FQI:
         agent = cls.__new__(cls)
         agent.__dict__.update({k: v for k, v in state.items() if k not in names})
         agent._set_params({**{name: state[name] for name in names}, **params})
-        agent._env = agent._eval_env = agent._collector = agent._data = None
+        agent._env = agent._eval_env = agent._collector = agent._data = agent._logger = None
         env = agent.env if env is None else env
         if env is not None:
             agent.set_env(env)
@@ -570,9 +623,11 @@ class FQI:
         """The agent's attributes for pickle: with its envs (an env that does not pickle
         makes the agent unpicklable) and random streams, so an unpickled agent learns on
         exactly as this one would; less the threads, and less the transitions when the next
-        iteration replaces them. A ``log_path`` travels too: a copy appends to its CSV."""
+        iteration replaces them, and less the `logger` (a copy starts with the default one).
+        A ``log_path`` travels: a copy appends to its CSV."""
         state = self.__dict__.copy()
         state["_pool"] = None  # threads do not pickle; a new pool starts on demand
+        state["_logger"] = None  # SB3's loggers hold open files
         if self._collects() and not self.keep_data:
             state["_data"] = None
         return state

@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import gymnasium as gym
 import numpy as np
+from sklearn.base import clone
 from sklearn.linear_model import Ridge
 from sklearn.pipeline import make_pipeline
 
@@ -13,7 +14,7 @@ from boxtrees import BoxExtraTreesRegressor, GridCounts
 from ._checks import _check_bool, _check_int, _check_n_jobs, _check_real, _check_seed
 from ._envs import _spaces
 from ._evaluate import _eval_seeds, evaluate
-from ._observations import _object_bounds, _ObjectRows
+from ._observations import _object_bounds, _ObjectRows, _view_bounds
 from ._wrappers import GridObservation
 
 __all__ = ["make_box_forest", "make_grid_ridge", "train_dqn", "DQNResult"]
@@ -64,7 +65,7 @@ def make_box_forest(env=None, *, test_type="fixed", test_width=1.0, n_estimators
     if view_bounds is None and env is not None:
         space = _spaces(env)[0]
         if not isinstance(space, gym.spaces.Box):
-            view_bounds = _object_bounds(space)[0]
+            view_bounds = _view_bounds(space)
     # what the forest's constraints let through: True for an int, n_jobs=0 (joblib's error)
     n_estimators = _check_int("n_estimators", n_estimators, 1)
     n_tests = _check_int("n_tests", n_tests, 1)
@@ -111,9 +112,11 @@ def make_grid_ridge(env=None, *, n_bins=10, alpha=1.0, view_bounds=None, n_types
                             "view_bounds and n_types")
     else:
         view_bounds, n_types = _object_bounds(_spaces(env)[0], view_bounds, n_types)
+    grid = GridCounts(_check_int("n_bins", n_bins, 1), view_bounds=view_bounds,
+                      n_types=n_types)
+    clone(grid).fit([np.empty((0, 3))])  # its checks, now rather than at the first fit
     return make_pipeline(
-        GridCounts(_check_int("n_bins", n_bins, 1), view_bounds=view_bounds, n_types=n_types),
-        Ridge(alpha=_check_real("alpha", alpha, 0.0, np.inf, high_inclusive=False)))
+        grid, Ridge(alpha=_check_real("alpha", alpha, 0.0, np.inf, high_inclusive=False)))
 
 
 class _GridModelPolicy:
@@ -199,9 +202,17 @@ def train_dqn(env, total_timesteps=400_000, *, n_bins=10, gamma=0.5, eval_episod
     seed = _check_seed("seed", seed)
     torch_threads = _check_int("torch_threads", torch_threads, 1)
     progress_bar = _check_bool("progress_bar", progress_bar)
+    reserved = sorted({"policy", "env", "gamma", "seed", "device"} & set(dqn_kwargs))
+    if reserved:
+        raise TypeError(f"train_dqn sets {reserved} itself (gamma and seed are its own "
+                        f"arguments); they cannot be DQN keywords")
     train_env = GridObservation(gym.make(env), n_bins=n_bins)
-    model = DQN("MlpPolicy", train_env, gamma=gamma, seed=seed, device="cpu",
-                **{**_DQN_DEFAULTS, **dqn_kwargs})
+    try:
+        model = DQN("MlpPolicy", train_env, gamma=gamma, seed=seed, device="cpu",
+                    **{**_DQN_DEFAULTS, **dqn_kwargs})
+    except BaseException:
+        train_env.close()
+        raise
     if model.tensorboard_log is None:
         # SB3's own logger would create an unused /tmp/SB3-<time> folder on every call
         model.set_logger(Logger(None, [HumanOutputFormat(sys.stdout)] if model.verbose else []))

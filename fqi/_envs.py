@@ -50,6 +50,13 @@ def _make_vector(env, n_envs):
     return SyncVectorEnv([partial(_called, env)] * n_envs)
 
 
+def _close_built(vector, env):
+    """Close `vector` when `_make_vector` built it from `env` (a vector env given as it is
+    stays the caller's, open)."""
+    if vector is not None and vector is not env:
+        vector.close()
+
+
 def _rebuildable(spec):
     """Whether ``gymnasium.make(spec)`` rebuilds the env that carries `spec`: it has an entry
     point and every wrapper recorded its arguments."""

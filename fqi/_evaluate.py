@@ -5,8 +5,8 @@ import numpy as np
 from gymnasium.vector import AutoresetMode
 
 from ._checks import _check_int, _check_seed
-from ._envs import (_TRAINING_SEED_END, _autoreset_mode, _make_vector, _n_actions,
-                    _seeded_reset, _spaces)
+from ._envs import (_TRAINING_SEED_END, _autoreset_mode, _close_built, _make_vector,
+                    _n_actions, _seeded_reset, _spaces)
 from ._observations import _observation_format
 
 __all__ = ["evaluate", "Evaluation", "RandomPolicy"]
@@ -88,6 +88,15 @@ class RandomPolicy:
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         """Uniform random actions: one for one observation, one per observation of a batch.
 
+        Parameters
+        ----------
+        observation : array-like
+            One observation of the env's space, or a batch of them (as its vector env
+            returns them); checked, then only its size is used.
+        state, episode_start, deterministic
+            Ignored (stable-baselines3's signature): the actions are random whatever
+            `deterministic`.
+
         Returns
         -------
         actions : int or ndarray of int
@@ -150,13 +159,16 @@ def evaluate(policy, env, n_episodes=None, seeds=None):
     if not seeds:
         raise ValueError("n_episodes must be >= 1 (or give at least one seed)")
     vector = _make_vector(env, len(seeds))
-    n_actions = _n_actions(vector.single_action_space)
     returns, lengths = [], []
-    for start in range(0, len(seeds), vector.num_envs):
-        round_returns, round_lengths = _play_round(policy, vector, n_actions,
-                                                   seeds[start:start + vector.num_envs])
-        returns.append(round_returns)
-        lengths.append(round_lengths)
+    try:
+        n_actions = _n_actions(vector.single_action_space)
+        for start in range(0, len(seeds), vector.num_envs):
+            round_returns, round_lengths = _play_round(policy, vector, n_actions,
+                                                       seeds[start:start + vector.num_envs])
+            returns.append(round_returns)
+            lengths.append(round_lengths)
+    finally:
+        _close_built(vector, env)
     returns, lengths = np.concatenate(returns), np.concatenate(lengths)
     return Evaluation(float(returns.sum()), float(returns.mean()), float(returns.std()),
                       returns, lengths, seeds)

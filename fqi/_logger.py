@@ -1,4 +1,5 @@
-"""One CSV row per FQI iteration."""
+"""FQI's logs: one CSV row per iteration (`CSVLogger`), and the key-value logger that
+stable-baselines3 callbacks write to (`_KeyValueLogger`, the default of `FQI.logger`)."""
 import csv
 import os
 from pathlib import Path
@@ -46,3 +47,43 @@ class CSVLogger:
 
     def __repr__(self):
         return f"CSVLogger({str(self.path)!r})"
+
+
+class _KeyValueLogger:
+    """The part of ``stable_baselines3.common.logger.Logger`` that callbacks use, in memory
+    and writing nowhere: `FQI.logger` until `FQI.set_logger` gives a real one.
+
+    ``record`` sets a value, ``record_mean`` averages the values given since the last
+    ``dump``, and ``dump`` clears them (as SB3's logger does after writing them).
+    """
+
+    def __init__(self):
+        self.name_to_value, self.name_to_count, self.name_to_excluded = {}, {}, {}
+
+    def record(self, key, value, exclude=None):
+        """Set `key` to `value` until the next `dump`."""
+        self.name_to_value[key] = value
+        self.name_to_excluded[key] = exclude
+
+    def record_mean(self, key, value, exclude=None):
+        """Average `value` into `key` (None is ignored) until the next `dump`."""
+        if value is None:
+            return
+        count = self.name_to_count.get(key, 0)
+        mean = self.name_to_value.get(key, 0.0)
+        self.name_to_value[key] = mean + (value - mean) / (count + 1)
+        self.name_to_count[key] = count + 1
+        self.name_to_excluded[key] = exclude
+
+    def dump(self, step=0):
+        """Clear the recorded values (they are written nowhere)."""
+        self.name_to_value.clear()
+        self.name_to_count.clear()
+        self.name_to_excluded.clear()
+
+    def get_dir(self):
+        """None: this logger has no directory."""
+        return None
+
+    def close(self):
+        """Nothing to close."""

@@ -138,6 +138,26 @@ def _rows(observation):
     return np.asarray(observation, dtype=np.float32).reshape(-1, 3)
 
 
+def _row_box(space):
+    """The ``Box`` of the rows of object-set observations ``Sequence(Box(shape=(3,)))``."""
+    if not (isinstance(space, spaces.Sequence) and isinstance(space.feature_space, spaces.Box)
+            and space.feature_space.shape == (3,)):
+        raise TypeError(f"view bounds and object types are read from object-set "
+                        f"observations, Sequence(Box(shape=(3,))); got {space}")
+    return space.feature_space
+
+
+def _view_bounds(space):
+    """The view square ``(xmin, xmax, ymin, ymax)`` of object-set observations: the x and y
+    bounds of their rows."""
+    box = _row_box(space)
+    view_bounds = tuple(float(v) for v in (box.low[0], box.high[0], box.low[1], box.high[1]))
+    if not np.isfinite(view_bounds).all():
+        raise ValueError(f"the object rows of {space} have unbounded x or y; give "
+                         f"view_bounds=(xmin, xmax, ymin, ymax)")
+    return view_bounds
+
+
 def _object_bounds(space, view_bounds=None, n_types=None):
     """The view square and number of types of object-set observations, read from the bounds
     of their rows' ``Box`` where not given.
@@ -147,16 +167,9 @@ def _object_bounds(space, view_bounds=None, n_types=None):
     view_bounds : tuple of 4 floats ``(xmin, xmax, ymin, ymax)``
     n_types : int
     """
-    if not (isinstance(space, spaces.Sequence) and isinstance(space.feature_space, spaces.Box)
-            and space.feature_space.shape == (3,)):
-        raise TypeError(f"view bounds and object types are read from object-set "
-                        f"observations, Sequence(Box(shape=(3,))); got {space}")
-    low, high = space.feature_space.low, space.feature_space.high
+    high = _row_box(space).high
     if view_bounds is None:
-        view_bounds = tuple(float(v) for v in (low[0], high[0], low[1], high[1]))
-        if not np.isfinite(view_bounds).all():
-            raise ValueError(f"the object rows of {space} have unbounded x or y; give "
-                             f"view_bounds=(xmin, xmax, ymin, ymax)")
+        view_bounds = _view_bounds(space)
     if n_types is None:
         if not np.isfinite(high[2]):
             raise ValueError(f"the object rows of {space} have an unbounded type; give "

@@ -5,6 +5,8 @@ from gymnasium import spaces
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
+from ._checks import _check_bool
+
 __all__ = ["SetEncoder"]
 
 
@@ -58,10 +60,15 @@ class SetEncoder(BaseFeaturesExtractor):
                             ("n_heads", n_heads)):
             if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < 1:
                 raise ValueError(f"{name} must be a positive int, got {value!r}")
+        attention = _check_bool("attention", attention)
         if attention and embed_dim % n_heads:
             raise ValueError(f"n_heads ({n_heads}) must divide embed_dim ({embed_dim})")
-        super().__init__(observation_space, features_dim)
         high, low = observation_space.high[0], observation_space.low[0]
+        if not (np.isfinite(high[2]) and high[2] >= 0):
+            raise ValueError(f"SetEncoder reads the number of types from the upper bound of "
+                             f"the type column, which must be finite and >= 0; got "
+                             f"{high[2]} in {observation_space}")
+        super().__init__(observation_space, features_dim)
         self.n_types = int(high[2]) + 1
         scale = float(np.max(np.abs([low[:2], high[:2]])))
         self.scale = scale if np.isfinite(scale) and scale > 0 else 1.0

@@ -498,6 +498,8 @@ def test_regressor_without_object_sets_is_told_to_wrap_them():
     ({"seed": -1}, ValueError, "seed must be >= 0"),
     ({"torch_threads": 0}, ValueError, "torch_threads must be >= 1"),
     ({"progress_bar": 1}, TypeError, "progress_bar must be a bool"),
+    ({"device": "cuda"}, TypeError, r"train_dqn sets \['device'\] itself"),
+    ({"policy": "CnnPolicy"}, TypeError, r"train_dqn sets \['policy'\] itself"),
 ])
 def test_train_dqn_checks_every_argument_before_training(monkeypatch, kwargs, error, match):
     from stable_baselines3 import DQN
@@ -521,6 +523,9 @@ def test_train_dqn_checks_every_argument_before_training(monkeypatch, kwargs, er
     (lambda: make_grid_ridge(ENV, alpha=-1.0), ValueError, r"alpha must lie in \[0.0, inf\)"),
     (lambda: make_grid_ridge(ENV, alpha=float("nan")), ValueError, "alpha"),
     (lambda: make_grid_ridge(), TypeError, "needs an env observing object sets"),
+    (lambda: make_grid_ridge(view_bounds=(0, 0, 0, 1), n_types=2), ValueError,
+     "xmin < xmax"),
+    (lambda: make_grid_ridge(view_bounds=5, n_types=0), ValueError, "'n_types' parameter"),
     (lambda: make_box_forest("CartPole-v1").view_bounds is None or 1 / 0, None, None),
     (lambda: RandomPolicy(ENV, seed=-1), ValueError, "seed must be >= 0"),
     (lambda: RandomPolicy(ENV, seed=True), TypeError, "seed must be an int"),

@@ -161,6 +161,22 @@ def test_object_set_env_with_box_trees():
     assert make_grid_ridge(Coins)[0].n_types == 2
 
 
+class AnyTypes(Coins):
+    """Coins whose rows leave the type id unbounded: the view square is still known."""
+
+    def __init__(self):
+        super().__init__()
+        row = spaces.Box(np.array([-5, -5, 0]), np.array([5, 5, np.inf]), dtype=np.float32)
+        self.observation_space = spaces.Sequence(row, stack=True)
+
+
+def test_a_forest_needs_only_the_view_square_a_grid_also_the_types():
+    assert make_box_forest(AnyTypes).view_bounds == (-5.0, 5.0, -5.0, 5.0)
+    with pytest.raises(ValueError, match="unbounded type; give n_types"):
+        make_grid_ridge(AnyTypes)
+    assert make_grid_ridge(AnyTypes, n_types=3)[0].n_types == 3
+
+
 # ---------------------------------------------------------------- vector envs and autoreset
 def _plain_rollouts(seeds, policy, n_steps):
     """Per env: the transitions of a plain step-by-step rollout (reset with its seed, then
@@ -351,6 +367,72 @@ def test_stable_baselines3_callbacks_are_called_and_can_stop():
     assert agent.iteration == 4 and watcher.events == ["start", "step", "step", "end"]
     agent.learn(5, callback=[watcher, lambda locals_, globals_: plain.append(1) or False])
     assert agent.iteration == 5 and plain == [1]
+
+
+@pytest.mark.filterwarnings("ignore:Training and eval env are not of the same type")
+def test_stable_baselines3_eval_callback_and_logger():
+    """SB3's EvalCallback runs on the agent and logs through `FQI.logger`; an SB3 logger
+    given by `set_logger` receives each iteration's record under ``fqi/``."""
+    from stable_baselines3.common.callbacks import EvalCallback
+    from stable_baselines3.common.logger import KVWriter, Logger
+
+    class Written(KVWriter):
+        def __init__(self):
+            self.dumps = []
+
+        def write(self, key_values, key_excluded, step=0):
+            self.dumps.append((step, dict(key_values)))
+
+    agent = FQI(classic_forest(), "CartPole-v1", samples_per_iteration=100, eval_episodes=1,
+                seed=0)
+    evaluation = EvalCallback(gym.make("CartPole-v1"), eval_freq=1, n_eval_episodes=2,
+                              warn=False, verbose=0)
+    agent.learn(2, callback=evaluation)  # it warns that our vector env is not SB3's
+    assert evaluation.n_calls == 2 and evaluation.last_mean_reward >= 8
+    assert agent.logger.name_to_value == {}  # dumped after each iteration, and by the callback
+    written = Written()
+    agent.set_logger(Logger(None, [written]))
+    agent.learn(1, callback=EvalCallback(gym.make("CartPole-v1"), eval_freq=1,
+                                         n_eval_episodes=2, warn=False, verbose=0))
+    (step, values), (eval_step, eval_values) = written.dumps
+    assert step == eval_step == agent.num_timesteps
+    assert values["fqi/iteration"] == 2 and values["fqi/reward"] == agent.history[-1]["reward"]
+    assert set(values) == {f"fqi/{key}" for key in agent.history[-1]}
+    assert "eval/mean_reward" in eval_values
+    assert pickle.loads(pickle.dumps(agent)).logger is not agent.logger  # not pickled
+    with pytest.raises(TypeError, match="logger must have record and dump"):
+        agent.set_logger(print)
+
+
+class Closing(Countdown):
+    """Counts the `close` calls of its instances."""
+
+    closed = 0
+
+    def close(self):
+        Closing.closed += 1
+
+
+def test_the_vector_envs_the_agent_builds_are_closed_and_given_ones_are_not():
+    Closing.closed = 0
+    policy = RandomPolicy(Closing(), seed=0)
+    evaluate(policy, Closing, seeds=[0, 1, 2])
+    assert Closing.closed == 3
+    given = SyncVectorEnv([Closing, Closing])
+    evaluate(policy, given, seeds=[0, 1, 2])
+    assert Closing.closed == 3 and not given.closed
+    agent = FQI(classic_forest(), Closing, n_envs=2, samples_per_iteration=20,
+                eval_episodes=2)
+    assert Closing.closed == 3  # the agent's own: training and evaluation
+    agent.set_env(given, eval_env=Closing)
+    assert Closing.closed == 7 and not given.closed  # 2 training + 2 evaluation envs
+    agent.set_env(Closing)
+    assert Closing.closed == 9 and not given.closed  # the evaluation's, not the given ones
+    kept = agent.get_env()
+    with pytest.raises(ValueError, match="the agent was made for"):
+        agent.set_env(Coins)
+    assert Closing.closed == 9 and agent.get_env() is kept and not kept.closed
+    agent.learn(1)
 
 
 def test_save_load_round_trip_on_a_box_env(tmp_path):

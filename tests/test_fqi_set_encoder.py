@@ -70,3 +70,11 @@ def test_bad_parameters_are_rejected(kwargs, match):
         SetEncoder(padded_env().observation_space, **kwargs)
     with pytest.raises(ValueError, match=r"shape \(max_objects, 4\)"):
         SetEncoder(gym.spaces.Box(0, 1, (5, 3)))
+
+
+def test_an_unbounded_type_column_or_a_non_bool_attention_is_rejected():
+    high = np.array([[1.0, 1.0, np.inf, 1.0]] * 5, dtype=np.float32)
+    with pytest.raises(ValueError, match="type column, which must be finite"):
+        SetEncoder(gym.spaces.Box(-high, high))
+    with pytest.raises(TypeError, match="attention must be a bool"):
+        SetEncoder(padded_env().observation_space, attention=1)
