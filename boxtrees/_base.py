@@ -177,6 +177,11 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         indicator.sort_indices()
         return indicator, starts
 
+    def __sklearn_is_fitted__(self):
+        """Fitted once ``fit`` has grown the trees: a ``fit`` that failed (say, on bad ``y``
+        after ``X`` was validated) leaves other fitted attributes, but no trees."""
+        return "_packed" in self.__dict__
+
     def __getstate__(self):
         state = dict(super().__getstate__())  # a copy: object.__getstate__ returns __dict__ itself
         state.pop("_packed", None)

@@ -15,8 +15,19 @@ __all__ = ["BoxExtraTreeClassifier", "BoxExtraTreeRegressor"]
 _SEED_MAX = np.iinfo(np.int64).max
 
 
-def tree_seed(random_state):
-    """The seed of one tree's generator: an int is used as it is, otherwise one is drawn."""
+def _tree_seed(random_state):
+    """The seed of one tree's generator: an int is used as it is, otherwise one is drawn.
+
+    Parameters
+    ----------
+    random_state : int, RandomState instance or None
+        The tree's ``random_state`` parameter (already validated).
+
+    Returns
+    -------
+    seed : int
+        An int in ``[0, 2**63 - 1)`` when drawn.
+    """
     if isinstance(random_state, Integral):
         return int(random_state)
     return int(check_random_state(random_state).randint(_SEED_MAX, dtype=np.int64))
@@ -70,7 +81,7 @@ class _SingleTree(BaseBoxTrees):
         -------
         self : estimator
         """
-        (self.tree_,) = trees = self._fit_trees(X, y, sample_weight, [tree_seed(self.random_state)])
+        (self.tree_,) = trees = self._fit_trees(X, y, sample_weight, [_tree_seed(self.random_state)])
         self._pack(trees)
         return self
 
@@ -78,12 +89,25 @@ class _SingleTree(BaseBoxTrees):
         return [self.tree_] if "tree_" in self.__dict__ else None
 
     def apply(self, X):
-        """Id of the leaf each sample reaches, shape (n_samples,)."""
+        """Return the index of the leaf each sample reaches.
+
+        Parameters
+        ----------
+        X : object sets or feature matrix, of the kind seen at fit
+
+        Returns
+        -------
+        X_leaves : ndarray of shape (n_samples,)
+            For each sample, the id of the leaf it ends in (a node id of ``tree_``).
+        """
+        check_is_fitted(self)
         return self._apply(X)[:, 0]
 
     def decision_path(self, X):
-        """Sparse indicator of shape (n_samples, node_count): 1 for the nodes each sample
-        passes through."""
+        """Return the nodes each sample passes through, from the root to its leaf, as a
+        CSR indicator matrix of shape ``(n_samples, tree_.node_count)``: 1 where sample
+        ``i`` passes through node ``j`` (`X` as for `apply`)."""
+        check_is_fitted(self)
         return self._decision_path(X, [self.tree_])[0]
 
     def get_depth(self):

@@ -78,8 +78,9 @@ def _check_rows(data, what="object sets"):
 class ObjectSets:
     """A batch of object sets stored as one array of rows plus offsets.
 
-    Set ``i`` is ``data[offsets[i]:offsets[i + 1]]``. Building one validates its content;
-    slicing and indexing return views or compact copies without re-validation. The arrays are
+    Set ``i`` is ``data[offsets[i]:offsets[i + 1]]``. Building one (with the constructor,
+    `from_sequence`, `from_features` or `concatenate`) validates its content; slicing and
+    indexing return views or compact copies without re-validation. The arrays are
     not frozen (``sets[i]`` is a writable view): the estimators check a batch again each time
     they are given it, and their kernels check every index they read, so a batch changed
     after it was built gets a clear error, never an out-of-bounds access.
@@ -152,14 +153,43 @@ class ObjectSets:
     def from_features(cls, X):
         """Read a 2D feature matrix as object sets: column ``j`` is one object of type ``j``.
 
-        The value is the object's x coordinate; y is 0.
+        The value is the object's x coordinate (as float32); y is 0. Every sample is a set of
+        ``n_features`` objects, one of each type.
 
         Parameters
         ----------
-        X : ndarray of shape (n_samples, n_features)
-            Finite values (already validated).
+        X : array-like of shape (n_samples, n_features)
+            Real, finite values that fit in float32; at most ``2**24`` features (the type
+            ids float32 holds exactly).
+
+        Returns
+        -------
+        ObjectSets
+            ``n_samples`` sets of ``n_features`` objects.
+
+        Raises
+        ------
+        TypeError
+            If ``X`` does not hold real numbers.
+        ValueError
+            If ``X`` is not 2D, holds NaN, infinite or too large values, or has too many
+            features.
         """
+        X = np.asarray(X)
+        if X.dtype.kind not in "biuf":
+            raise TypeError(f"X must hold real numbers, got an array of dtype {X.dtype}")
+        if X.ndim != 2:
+            raise ValueError(
+                f"X must be a 2D feature matrix of shape (n_samples, n_features); got shape {X.shape}"
+            )
         n_samples, n_features = X.shape
+        if n_features > _MAX_TYPE:
+            raise ValueError(f"X has {n_features} features; at most {_MAX_TYPE} are supported")
+        if X.dtype.kind == "f" and X.size:
+            if not np.isfinite(X).all():
+                raise ValueError("X contains NaN or infinite values")
+            if X.dtype.itemsize > 4 and np.abs(X).max() > _FLOAT32_MAX:
+                raise ValueError("X has values too large for float32 (|value| > 3.4e38)")
         data = np.zeros((n_samples * n_features, 3), dtype=np.float32)
         data[:, 0] = X.ravel()
         data[:, 2] = np.tile(np.arange(n_features, dtype=np.float32), n_samples)
@@ -167,12 +197,55 @@ class ObjectSets:
 
     @classmethod
     def concatenate(cls, batches):
-        """Join several batches into one, set order preserved."""
-        batches = list(batches)
+        """Join several batches into one, set order preserved.
+
+        Each batch is checked as the constructor checks its arguments (its arrays may have
+        changed since it was built), in one pass over its rows and offsets.
+
+        Parameters
+        ----------
+        batches : iterable of ObjectSets
+            The batches, in order; none gives an empty batch.
+
+        Returns
+        -------
+        ObjectSets
+            ``len(result) == sum(len(b) for b in batches)``.
+
+        Raises
+        ------
+        TypeError
+            If ``batches`` is not an iterable of ObjectSets (a single ObjectSets must be
+            wrapped in a list).
+        ValueError
+            If the rows or offsets of a batch are invalid, naming the batch.
+        """
+        if isinstance(batches, ObjectSets) or _is_ragged_batch(batches):
+            raise TypeError("ObjectSets.concatenate takes an iterable of ObjectSets, got a single "
+                            "batch; wrap it in a list")
+        try:
+            batches = list(batches)
+        except TypeError:
+            raise TypeError(f"ObjectSets.concatenate takes an iterable of ObjectSets, got "
+                            f"{type(batches).__name__}") from None
         if not batches:
             return cls._trusted(np.empty((0, 3), dtype=np.float32), np.zeros(1, dtype=np.intp))
-        data = np.concatenate([b.data for b in batches])
-        return cls._trusted(data, _offsets_from_sizes(np.concatenate([b.sizes for b in batches])))
+        data, sizes = [], []
+        for i, batch in enumerate(batches):
+            if not isinstance(batch, ObjectSets):
+                raise TypeError(
+                    f"ObjectSets.concatenate takes ObjectSets; batch {i} is a "
+                    f"{type(batch).__name__} (wrap arrays with ObjectSets(data, offsets) or "
+                    f"ObjectSets.from_sequence)"
+                )
+            rows = _check_rows(batch.data, what=f"the rows of batch {i} of ObjectSets.concatenate")
+            try:
+                offsets = _check_offsets(batch.offsets, len(rows))
+            except ValueError as error:
+                raise ValueError(f"batch {i} of ObjectSets.concatenate: {error}") from None
+            data.append(rows)
+            sizes.append(np.diff(offsets))
+        return cls._trusted(np.concatenate(data), _offsets_from_sizes(np.concatenate(sizes)))
 
     def __len__(self):
         return len(self.offsets) - 1

@@ -215,3 +215,51 @@ def test_fuzz_arbitrary_arrays_fail_only_with_value_or_type_errors(raw):
     except (ValueError, TypeError):
         return
     assert np.isfinite(forest.predict(raw)).all()
+
+
+# --- before fit -------------------------------------------------------------------------------
+
+UNFITTED_CALLS = {
+    "predict": lambda e: e.predict(GOOD),
+    "apply": lambda e: e.apply(GOOD),
+    "decision_path": lambda e: e.decision_path(GOOD),
+    "score": lambda e: e.score(GOOD, [0, 1, 0]),
+    "feature_importances_": lambda e: e.feature_importances_,
+    "get_depth": lambda e: e.get_depth(),
+    "get_n_leaves": lambda e: e.get_n_leaves(),
+    "predict_proba": lambda e: e.predict_proba(GOOD),
+    "predict_log_proba": lambda e: e.predict_log_proba(GOOD),
+}
+
+
+def _unfitted_cases():
+    from boxtrees import BoxExtraTreeClassifier, BoxExtraTreeRegressor, BoxExtraTreesClassifier
+
+    for cls in (BoxExtraTreeRegressor, BoxExtraTreeClassifier, BoxExtraTreesRegressor,
+                BoxExtraTreesClassifier):
+        for name, call in UNFITTED_CALLS.items():
+            if name == "feature_importances_" or hasattr(cls, name):
+                yield pytest.param(cls, call, id=f"{cls.__name__}.{name}")
+
+
+@pytest.mark.parametrize("cls, call", list(_unfitted_cases()))
+def test_every_prediction_method_raises_not_fitted_error_before_fit(cls, call):
+    from sklearn.exceptions import NotFittedError
+
+    with pytest.raises(NotFittedError, match=f"This {cls.__name__} instance is not fitted yet"):
+        call(cls())
+
+
+@pytest.mark.parametrize("method", ["predict", "apply", "decision_path", "predict_proba"])
+@pytest.mark.parametrize("single", [True, False], ids=["tree", "forest"])
+def test_an_estimator_whose_fit_failed_is_not_fitted(method, single):
+    from sklearn.exceptions import NotFittedError
+
+    from boxtrees import BoxExtraTreeClassifier, BoxExtraTreesClassifier
+
+    estimator = BoxExtraTreeClassifier() if single else BoxExtraTreesClassifier()
+    X = np.zeros((3, 2))
+    with pytest.raises(ValueError, match="Unknown label type"):
+        estimator.fit(X, [0.5, 1.5, 2.5])  # fails after validating X (n_features_in_ is set)
+    with pytest.raises(NotFittedError):
+        getattr(estimator, method)(X)
