@@ -7,9 +7,8 @@ from ._rules import ARROW, ENEMY, GRASS, MONEY, MONEY_MARKER, TREASURE_MARKER, W
 
 _BACKGROUND = (245, 240, 226)
 _VIEW_COLOUR = (40, 60, 140)
-_AGENT = ((20, 20, 20), "disc", 0.55)
-# Per type: colour, shape, radius in world units.
-# RGB colour of each object type, as drawn (and as the benchmark figures show it)
+_AGENT = ((20, 20, 20), "disc", 0.55)  # the agent's sprite: colour, shape, radius
+# RGB colour of each object type, as drawn (and as the benchmark figures show it).
 TYPE_COLOURS = {
     MONEY: (226, 178, 18),
     WALL: (100, 100, 106),
@@ -19,7 +18,7 @@ TYPE_COLOURS = {
     TREASURE_MARKER: (40, 90, 220),
     ARROW: (140, 60, 200),
 }
-# the sprite of each type: colour, shape, radius in units
+# The sprite of each type: colour (from TYPE_COLOURS), shape, radius in world units.
 _STYLE = {
     kind: (TYPE_COLOURS[kind], shape, radius)
     for kind, shape, radius in [

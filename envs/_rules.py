@@ -55,23 +55,43 @@ def reference_worlds(n=400):
     seeds : list of int
         Pass them to ``BatchedObjectWorld(n).reset(seed=seeds)``, or one at a time to
         ``ObjectWorldEnv.reset(seed=s)``.
+
+    Raises
+    ------
+    TypeError
+        If `n` is not an int (bools and floats such as ``2.0`` included).
+    ValueError
+        If `n` is negative.
     """
-    if not isinstance(n, Integral) or isinstance(n, bool) or n < 0:
+    if not isinstance(n, Integral) or isinstance(n, bool):
+        raise TypeError(f"n must be a non-negative int, got {n!r}")
+    if n < 0:
         raise ValueError(f"n must be a non-negative int, got {n!r}")
     return [REFERENCE_SEED_START + i for i in range(int(n))]
 
 
-def _check_int(name, value, low, type_error=ValueError):
-    """`value` as an int ``>= low``; a non-int (bools included) raises `type_error`."""
+def _check_int(name, value, low):
+    """`value` as an int ``>= low``.
+
+    As scikit-learn's parameter checks: a value that is not an int (a float such as 1.5 or
+    even 2.0, a bool, a str) raises a TypeError; an int below `low` raises a ValueError.
+    """
     if not isinstance(value, Integral) or isinstance(value, bool):
-        raise type_error(f"{name} must be an int, got {value!r}")
+        raise TypeError(f"{name} must be an int, got {value!r}")
     if value < low:
         raise ValueError(f"{name} must be >= {low}, got {value}")
     return int(value)
 
 
 def _check_float(name, value, low, high=math.inf, low_inclusive=True):
-    if not isinstance(value, Real) or isinstance(value, bool) or not math.isfinite(value):
+    """`value` as a float in ``[low, high]`` (``(low, high]`` unless `low_inclusive`).
+
+    A value that is not a real number (a bool, a str, None) raises a TypeError; NaN, an
+    infinity or a number out of range raises a ValueError.
+    """
+    if not isinstance(value, Real) or isinstance(value, bool):
+        raise TypeError(f"{name} must be a finite number, got {value!r}")
+    if not math.isfinite(value):
         raise ValueError(f"{name} must be a finite number, got {value!r}")
     if value < low or (value == low and not low_inclusive) or value > high:
         bound = "[" if low_inclusive else "("
@@ -86,7 +106,7 @@ class WorldRules:
     `ObjectWorldEnv(**rules)` and `BatchedObjectWorld(n_worlds, **rules)` take these fields as
     keyword arguments. The defaults are the thesis game (section 1.2) with the constants the
     thesis leaves open calibrated so that the uniform random policy scores about -5 per step
-    (see the README, section "envs").
+    (see docs/game.md, section "Calibration").
 
     Parameters
     ----------
@@ -142,6 +162,17 @@ class WorldRules:
         Type ids of observed objects lie in ``range(n_types)``: 4, 6 (minimap) or 7 (arrow).
     obs_bound : float
         Bound on ``|dx|`` and ``|dy|`` of observed objects.
+
+    Raises
+    ------
+    TypeError
+        If a constant is not of its type: `sword` and `treasure` bools, the counts and
+        `max_steps` ints (not bools, not floats such as ``1.5`` or ``2.0``), the other
+        constants real numbers (not bools).
+    ValueError
+        If a constant is out of its range (a negative count, ``max_steps < 1``, NaN or an
+        infinite size, ...), `view` is unknown, or ``view="minimap"`` or ``"arrow"`` is
+        asked for without ``treasure=True``.
     """
 
     sword: bool = False
@@ -168,7 +199,7 @@ class WorldRules:
         for name in ("sword", "treasure"):
             value = getattr(self, name)
             if not isinstance(value, (bool, np.bool_)):
-                raise ValueError(f"{name} must be a bool, got {value!r}")
+                raise TypeError(f"{name} must be a bool, got {value!r}")
             checked[name] = bool(value)
         if self.view not in VIEWS:
             raise ValueError(f"unknown view {self.view!r}; expected one of {VIEWS}")
@@ -197,12 +228,38 @@ class WorldRules:
 
     @property
     def n_actions(self):
+        """Number of actions: 4 moves, or 8 with the sword (the moves, then the swipes).
+
+        Returns
+        -------
+        n_actions : int
+            4, or 8 if `sword`; the action space is ``Discrete(n_actions)``.
+        """
         return 8 if self.sword else 4
 
     @property
     def n_types(self):
+        """Number of object types an observation can hold.
+
+        Returns
+        -------
+        n_types : int
+            Type ids of observed objects lie in ``range(n_types)``: 4 (`MONEY`, `WALL`,
+            `GRASS`, `ENEMY`) for the ``"local"`` and ``"global"`` views, 6 for
+            ``"minimap"`` (plus `MONEY_MARKER` and `TREASURE_MARKER`), 7 for ``"arrow"``
+            (ids up to `ARROW`; the markers never appear in this view).
+        """
         return {"minimap": TREASURE_MARKER + 1, "arrow": ARROW + 1}.get(self.view, ENEMY + 1)
 
     @property
     def obs_bound(self):
+        """Bound on the agent-relative coordinates of observed objects.
+
+        Returns
+        -------
+        obs_bound : float
+            Every observed row ``[dx, dy, type]`` has ``|dx|, |dy| <= obs_bound``:
+            ``2 * size_w`` for the ``"global"`` view (the width of the world), `view_size`
+            for the others. It bounds the observation space's `Box`.
+        """
         return 2.0 * self.size_w if self.view == "global" else self.view_size

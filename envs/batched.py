@@ -92,19 +92,26 @@ class _RaggedBatchSpace(spaces.Tuple):
 
 
 def _world_seeds(seed, n):
-    """Per-world seeds from `seed`: an int (world i gets seed + i) or n ints."""
+    """Per-world seeds from `seed`: an int (world i gets seed + i) or n ints.
+
+    A `seed` that is neither an int nor a sequence, or a world seed that is not an int
+    (bools and floats included), raises a TypeError; a sequence of the wrong length or a
+    negative seed raises a ValueError.
+    """
     if isinstance(seed, Integral) and not isinstance(seed, bool):
         seeds = [int(seed) + i for i in range(n)]
     else:
         try:
             seeds = list(seed)
         except TypeError:
-            raise ValueError(f"seed must be None, an int or a sequence of {n} ints, "
-                             f"got {seed!r}") from None
+            raise TypeError(f"seed must be None, an int or a sequence of {n} ints, "
+                            f"got {seed!r}") from None
         if len(seeds) != n:
             raise ValueError(f"seed has {len(seeds)} entries for {n} worlds")
     for s in seeds:
-        if not isinstance(s, Integral) or isinstance(s, bool) or s < 0:
+        if not isinstance(s, Integral) or isinstance(s, bool):
+            raise TypeError(f"world seeds must be non-negative ints, got {s!r}")
+        if s < 0:
             raise ValueError(f"world seeds must be non-negative ints, got {s!r}")
     return [int(s) for s in seeds]
 
@@ -139,6 +146,15 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
         What `render` draws for each world, as in `ObjectWorldEnv`.
     **rules
         The rule constants of `ObjectWorldEnv` (see `WorldRules`).
+
+    Raises
+    ------
+    TypeError
+        If `n_worlds` is not an int (bools and floats such as ``2.0`` included), or a rule
+        constant is not of its type (see `WorldRules`).
+    ValueError
+        If `n_worlds` is below 1, a rule constant is out of range, or the rendering
+        arguments are unknown.
 
     Attributes
     ----------
@@ -184,7 +200,9 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
                 "render_fps": 8}
 
     def __init__(self, n_worlds, render_mode=None, render_view="world", **rules):
-        if not isinstance(n_worlds, Integral) or isinstance(n_worlds, bool) or n_worlds < 1:
+        if not isinstance(n_worlds, Integral) or isinstance(n_worlds, bool):
+            raise TypeError(f"n_worlds must be a positive int, got {n_worlds!r}")
+        if n_worlds < 1:
             raise ValueError(f"n_worlds must be a positive int, got {n_worlds!r}")
         self.rules = WorldRules(**rules)
         _check_render(render_mode, render_view)
@@ -202,10 +220,24 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
 
     @property
     def n_types(self):
+        """Number of object types the observations can hold (`WorldRules.n_types`).
+
+        Returns
+        -------
+        n_types : int
+            Type ids in every world's observation lie in ``range(n_types)``.
+        """
         return self.rules.n_types
 
     @property
     def view_size(self):
+        """Half-side of each world's view square (`WorldRules.view_size`).
+
+        Returns
+        -------
+        view_size : float
+            The local view holds the objects with ``|dx|, |dy| <= view_size``.
+        """
         return self.rules.view_size
 
     def reset(self, *, seed=None, options=None):
@@ -225,6 +257,14 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
         -------
         obs : RaggedBatch
         info : dict
+
+        Raises
+        ------
+        TypeError
+            If `seed` is neither None, an int nor a sequence, or a world seed is not an int.
+        ValueError
+            If a world seed is negative, a sequence does not hold one seed per world, or
+            `options` is malformed.
         """
         layout = _layout_from_options(options, self.rules)
         if seed is None and self._rngs is None:
@@ -251,6 +291,15 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
         rewards : ndarray of float64 of shape (num_envs,)
         terminated, truncated : ndarray of bool of shape (num_envs,)
         info : dict
+
+        Raises
+        ------
+        TypeError
+            If the actions are not ints (a float or bool dtype).
+        ValueError
+            If they are not of shape ``(num_envs,)`` or not in ``[0, n_actions)``.
+        RuntimeError
+            If `reset` was never called.
         """
         actions = self._check_actions(actions)
         if self._engine.observation is None:
@@ -281,7 +330,7 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
             raise ValueError(f"actions must have shape ({self.num_envs},), one per world; "
                              f"got shape {array.shape}")
         if not np.issubdtype(array.dtype, np.integer):
-            raise ValueError(f"actions must be ints, got dtype {array.dtype}")
+            raise TypeError(f"actions must be ints, got dtype {array.dtype}")
         n_actions = self.rules.n_actions
         if array.size and (array.min() < 0 or array.max() >= n_actions):
             bad = array[(array < 0) | (array >= n_actions)][0]

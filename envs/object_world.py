@@ -1,5 +1,6 @@
 """The ObjectWorld game as a gymnasium environment (one world)."""
 import copy
+from numbers import Integral
 
 import gymnasium as gym
 import numpy as np
@@ -89,13 +90,23 @@ class _OwnEpisodeLimit:
 
 
 def _check_action(action, n_actions):
-    """Return `action` as an int after checking it is a valid action id."""
-    if (isinstance(action, (bool, np.bool_))
-            or not spaces.Discrete(n_actions).contains(action)):
-        raise ValueError(
-            f"invalid action {action!r}: expected an int in [0, {n_actions}) "
-            f"(0 up, 1 right, 2 down, 3 left{', 4-7 swipes' if n_actions == 8 else ''})")
-    return int(action)
+    """Return `action` as an int after checking it is a valid action id.
+
+    The actions accepted are those of ``Discrete(n_actions).contains`` except bools. One that
+    is not an integer (a float such as ``1.0``, a bool, a str, None, an array of shape other
+    than ``()``) raises a TypeError; an integer outside ``[0, n_actions)`` a ValueError.
+    """
+    is_bool = isinstance(action, (bool, np.bool_))
+    if not is_bool and spaces.Discrete(n_actions).contains(action):
+        return int(action)
+    message = (f"invalid action {action!r}: expected an int in [0, {n_actions}) "
+               f"(0 up, 1 right, 2 down, 3 left{', 4-7 swipes' if n_actions == 8 else ''})")
+    is_integer = isinstance(action, Integral) or (
+        isinstance(action, np.ndarray) and action.shape == ()
+        and np.issubdtype(action.dtype, np.integer))
+    if is_bool or not is_integer:
+        raise TypeError(message)
+    raise ValueError(message)
 
 
 class ObjectWorldEnv(_OwnEpisodeLimit, gym.Env):
@@ -123,6 +134,13 @@ class ObjectWorldEnv(_OwnEpisodeLimit, gym.Env):
         `treasure`, `view`, `size_w`, `n_money`, `n_walls`, `n_grass`, `n_enemies`,
         `enemy_speed`, `contact_radius`, `move_noise`, `swipe_size`, `view_size`,
         `max_steps`, `n_treasure`, `treasure_radius`, `treasure_margin`, `start_clearance`.
+
+    Raises
+    ------
+    TypeError
+        If a rule constant is not of its type (see `WorldRules`), or is unknown.
+    ValueError
+        If a rule constant is out of range, or the rendering arguments are unknown.
 
     Attributes
     ----------
@@ -171,10 +189,24 @@ class ObjectWorldEnv(_OwnEpisodeLimit, gym.Env):
 
     @property
     def n_types(self):
+        """Number of object types the observations can hold (`WorldRules.n_types`).
+
+        Returns
+        -------
+        n_types : int
+            Type ids in observations (column 2) lie in ``range(n_types)``.
+        """
         return self.rules.n_types
 
     @property
     def view_size(self):
+        """Half-side of the agent's view square (`WorldRules.view_size`).
+
+        Returns
+        -------
+        view_size : float
+            The local view holds the objects with ``|dx|, |dy| <= view_size``.
+        """
         return self.rules.view_size
 
     def reset(self, *, seed=None, options=None):
@@ -200,7 +232,39 @@ class ObjectWorldEnv(_OwnEpisodeLimit, gym.Env):
         return self._engine.observation[0], {}
 
     def step(self, action):
-        """Apply `action`; returns ``(observation, reward, terminated, truncated, info)``."""
+        """Apply `action`: move or swipe, then let the enemies chase the agent.
+
+        Parameters
+        ----------
+        action : int
+            An action id in ``[0, n_actions)``: ``0`` up, ``1`` right, ``2`` down, ``3``
+            left; with the sword ``4..7`` swipe in the same directions. A numpy integer
+            (or a 0-d integer array) is accepted too; bools are not.
+
+        Returns
+        -------
+        observation : ndarray of float32 of shape (n, 3)
+            The objects in view after the step, rows ``[dx, dy, type]``.
+        reward : float
+            The sum of the step's rewards: contacts (money +100, wall -50, enemy -300) and,
+            with the sword, the swipe (+300, -900 or -750).
+        terminated : bool
+            Always False: the game has no terminal state.
+        truncated : bool
+            True on step `max_steps` of the episode.
+        info : dict
+            Empty.
+
+        Raises
+        ------
+        TypeError
+            If `action` is not an integer (a float such as ``1.0``, a bool, a str, None, an
+            array of shape other than ``()``).
+        ValueError
+            If it is an integer outside ``[0, n_actions)``.
+        RuntimeError
+            If `reset` was never called, or the episode was truncated and not reset since.
+        """
         action = _check_action(action, self.rules.n_actions)
         if self._engine.observation is None:
             raise RuntimeError("call reset() before step()")

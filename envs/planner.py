@@ -302,9 +302,9 @@ class LookaheadPlanner:
     """
 
     def __init__(self, depth=5, width=16, route_width=50, discount=0.95):
-        self.depth = _check_int("depth", depth, 1, TypeError)
-        self.width = _check_int("width", width, 1, TypeError)
-        self.route_width = _check_int("route_width", route_width, 1, TypeError)
+        self.depth = _check_int("depth", depth, 1)
+        self.width = _check_int("width", width, 1)
+        self.route_width = _check_int("route_width", route_width, 1)
         if not isinstance(discount, Real) or isinstance(discount, bool):
             raise TypeError(f"discount must be a number, got {discount!r}")
         if not 0.0 < discount <= 1.0:

@@ -2,7 +2,8 @@
 import numpy as np
 
 from ._rules import _DIRECTIONS, ENEMY, MONEY, WALL
-from .batched import _check_offsets
+from .batched import BatchedObjectWorld, _check_offsets
+from .object_world import ObjectWorldEnv
 
 __all__ = ["GreedyPolicy"]
 
@@ -48,7 +49,19 @@ class GreedyPolicy:
     Parameters
     ----------
     env : ObjectWorldEnv or BatchedObjectWorld
-        The (possibly wrapped) environment whose rules the policy plays by.
+        The (possibly wrapped) environment whose rules the policy plays by. Many worlds
+        are one `BatchedObjectWorld` (``gymnasium.make_vec(id, num_envs=n)`` builds one),
+        not a gymnasium ``SyncVectorEnv`` of single envs.
+
+    Raises
+    ------
+    TypeError
+        If `env` (unwrapped) is not an `ObjectWorldEnv` or a `BatchedObjectWorld`.
+
+    Attributes
+    ----------
+    rules : WorldRules
+        The rules of `env`, read once at construction.
 
     Examples
     --------
@@ -63,7 +76,13 @@ class GreedyPolicy:
     """
 
     def __init__(self, env):
-        self.rules = env.unwrapped.rules
+        base = getattr(env, "unwrapped", None)
+        if not isinstance(base, (ObjectWorldEnv, BatchedObjectWorld)):
+            raise TypeError(
+                "GreedyPolicy plays an ObjectWorldEnv or a BatchedObjectWorld (possibly "
+                f"wrapped), got {type(env).__name__}; for many worlds use "
+                "envs.BatchedObjectWorld(n) or gymnasium.make_vec(id, num_envs=n)")
+        self.rules = base.rules
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         """Actions for one observation or a batch (stable-baselines3 signature).

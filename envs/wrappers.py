@@ -26,6 +26,14 @@ class PaddedObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     max_objects : int
         Number of rows of the padded observation.
 
+    Raises
+    ------
+    TypeError
+        If `max_objects` is not an int (bools and floats such as ``8.0`` included).
+    ValueError
+        If `max_objects` is below 1, or the env's observation space is not
+        ``Sequence(Box(3,), stack=True)``.
+
     Examples
     --------
     >>> import gymnasium as gym
@@ -45,8 +53,9 @@ class PaddedObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
                 and space.feature_space.shape == (3,)):
             raise ValueError("PaddedObjects needs an observation space Sequence(Box(3,), "
                              f"stack=True), got {space}")
-        if not isinstance(max_objects, Integral) or isinstance(max_objects, bool) \
-                or max_objects < 1:
+        if not isinstance(max_objects, Integral) or isinstance(max_objects, bool):
+            raise TypeError(f"max_objects must be a positive int, got {max_objects!r}")
+        if max_objects < 1:
             raise ValueError(f"max_objects must be a positive int, got {max_objects!r}")
         self.max_objects = int(max_objects)
         row = space.feature_space
@@ -57,6 +66,20 @@ class PaddedObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
                                             dtype=np.float32)
 
     def observation(self, observation):
+        """Pad (or cut) one object set to the fixed ``(max_objects, 4)`` observation.
+
+        Parameters
+        ----------
+        observation : ndarray of float32 of shape (n, 3)
+            The wrapped env's observation, rows ``[dx, dy, type]``.
+
+        Returns
+        -------
+        padded : ndarray of float32 of shape (max_objects, 4)
+            Rows ``[dx, dy, type, 1]`` for the objects kept, then rows of zeros. If
+            ``n > max_objects``, the `max_objects` objects nearest to the agent are kept, in
+            their original order (ties at the cut broken by ``numpy.argpartition``).
+        """
         padded = np.zeros((self.max_objects, 4), dtype=np.float32)
         if len(observation) > self.max_objects:
             dist = np.hypot(observation[:, 0], observation[:, 1])

@@ -485,12 +485,33 @@ def test_greedy_policy_beats_random_play():
 
 
 # --------------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("action", [4, -1, 1.0, "up", None, np.array([1]), True])
-def test_invalid_action_is_a_value_error(action):
+@pytest.mark.parametrize("action", [4, -1, np.int64(7), np.array(-2)])
+def test_out_of_range_action_is_a_value_error(action):
     env = envs.ObjectWorldEnv()
     env.reset(seed=0)
     with pytest.raises(ValueError, match="invalid action"):
         env.step(action)
+
+
+@pytest.mark.parametrize("action", [1.0, 1.5, "up", None, np.array([1]), True, np.bool_(False),
+                                    np.float32(2.0)])
+def test_non_integer_action_is_a_type_error(action):
+    env = envs.ObjectWorldEnv()
+    env.reset(seed=0)
+    with pytest.raises(TypeError, match=r"invalid action .*expected an int in \[0, 4\)"):
+        env.step(action)
+
+
+@pytest.mark.parametrize("action", [2, np.int64(2), np.int32(2), np.array(2)])
+def test_integer_actions_of_any_kind_step_alike(action):
+    env = envs.ObjectWorldEnv()
+    env.reset(seed=3)
+    expected = envs.ObjectWorldEnv()
+    expected.reset(seed=3)
+    obs, reward, *_ = env.step(action)
+    want_obs, want_reward, *_ = expected.step(2)
+    assert reward == want_reward
+    np.testing.assert_array_equal(obs, want_obs)
 
 
 def test_sword_actions_need_the_sword():
@@ -506,19 +527,47 @@ def test_sword_actions_need_the_sword():
     ({"view": "arrow"}, "treasure=True"),
     ({"n_money": -1}, "n_money must be >= 0"),
     ({"n_enemies": -3}, "n_enemies must be >= 0"),
-    ({"n_walls": 2.5}, "n_walls must be an int"),
     ({"max_steps": 0}, "max_steps must be >= 1"),
     ({"size_w": float("nan")}, "size_w must be a finite number"),
+    ({"size_w": float("inf")}, "size_w must be a finite number"),
     ({"contact_radius": 0.3}, "contact_radius"),
     ({"enemy_speed": -0.1}, "enemy_speed"),
     ({"view_size": 0}, "view_size"),
-    ({"sword": "yes"}, "sword must be a bool"),
 ])
-def test_bad_rules_are_value_errors(rules, match):
+def test_out_of_range_rules_are_value_errors(rules, match):
     with pytest.raises(ValueError, match=match):
         envs.ObjectWorldEnv(**rules)
     with pytest.raises(ValueError, match=match):
         envs.BatchedObjectWorld(2, **rules)
+
+
+@pytest.mark.parametrize("rules, match", [
+    ({"n_walls": 2.5}, "n_walls must be an int, got 2.5"),
+    ({"n_money": 1.5}, "n_money must be an int, got 1.5"),
+    ({"n_money": 40.0}, "n_money must be an int, got 40.0"),
+    ({"n_enemies": True}, "n_enemies must be an int, got True"),
+    ({"max_steps": "50"}, "max_steps must be an int, got '50'"),
+    ({"n_treasure": None}, "n_treasure must be an int, got None"),
+    ({"sword": "yes"}, "sword must be a bool"),
+    ({"treasure": 1}, "treasure must be a bool"),
+    ({"size_w": "30"}, "size_w must be a finite number, got '30'"),
+    ({"enemy_speed": True}, "enemy_speed must be a finite number, got True"),
+    ({"view_size": None}, "view_size must be a finite number, got None"),
+])
+def test_rules_of_the_wrong_type_are_type_errors(rules, match):
+    with pytest.raises(TypeError, match=match):
+        envs.WorldRules(**rules)
+    with pytest.raises(TypeError, match=match):
+        envs.ObjectWorldEnv(**rules)
+    with pytest.raises(TypeError, match=match):
+        envs.BatchedObjectWorld(2, **rules)
+
+
+def test_integral_rules_of_numpy_types_are_accepted():
+    rules = envs.WorldRules(n_money=np.int64(5), max_steps=np.int32(7), sword=np.bool_(True),
+                            size_w=np.float32(20.0))
+    assert (rules.n_money, rules.max_steps, rules.sword, rules.size_w) == (5, 7, True, 20.0)
+    assert type(rules.n_money) is int and type(rules.size_w) is float
 
 
 def test_unknown_rule_is_a_type_error():
@@ -586,6 +635,11 @@ def test_greedy_policy_rejects_a_batch_with_bad_offsets():
 def test_bad_wrapper_input():
     with pytest.raises(ValueError, match="max_objects"):
         envs.PaddedObjects(envs.ObjectWorldEnv(), 0)
+    with pytest.raises(ValueError, match="max_objects"):
+        envs.PaddedObjects(envs.ObjectWorldEnv(), -4)
+    for max_objects in (8.0, 2.5, True, "8", None):
+        with pytest.raises(TypeError, match="max_objects must be a positive int"):
+            envs.PaddedObjects(envs.ObjectWorldEnv(), max_objects)
     with pytest.raises(ValueError, match="Sequence"):
         envs.PaddedObjects(gym.make("CartPole-v1"), 8)
     with pytest.raises(ValueError, match="valid"):
@@ -594,3 +648,33 @@ def test_bad_wrapper_input():
         envs.strip_padding(np.zeros(4))
     with pytest.raises(ValueError, match="non-negative"):
         envs.reference_worlds(-1)
+    for n in (2.0, 1.5, True, "4", None):
+        with pytest.raises(TypeError, match="n must be a non-negative int"):
+            envs.reference_worlds(n)
+
+
+# --------------------------------------------------------------------------- the policy's env
+@pytest.mark.parametrize("make_env", [
+    lambda: gym.make("CartPole-v1"),
+    lambda: gym.vector.SyncVectorEnv([lambda: envs.ObjectWorldEnv()] * 2),
+    lambda: gym.make_vec("ObjectWorld-v0", num_envs=2, vectorization_mode="sync"),
+    lambda: envs.WorldRules(),
+    lambda: None,
+    lambda: "ObjectWorld-v0",
+])
+def test_greedy_policy_needs_an_objectworld_env(make_env):
+    env = make_env()
+    with pytest.raises(TypeError, match="GreedyPolicy plays an ObjectWorldEnv or a "
+                                        "BatchedObjectWorld .*got "):
+        envs.GreedyPolicy(env)
+
+
+@pytest.mark.parametrize("make_env", [
+    lambda: envs.ObjectWorldEnv(sword=True),
+    lambda: gym.make("ObjectWorldSword-v0"),
+    lambda: envs.PaddedObjects(envs.ObjectWorldEnv(sword=True), 8),
+    lambda: envs.BatchedObjectWorld(2, sword=True),
+    lambda: gym.make_vec("ObjectWorldSword-v0", num_envs=2),
+])
+def test_greedy_policy_takes_objectworld_envs_wrapped_or_not(make_env):
+    assert envs.GreedyPolicy(make_env()).rules == envs.WorldRules(sword=True)

@@ -198,37 +198,47 @@ def test_layout_option_applies_to_every_world():
 
 
 # --------------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("actions, match", [
-    (np.zeros(3, dtype=int), r"shape \(4,\)"),
-    (np.zeros((4, 1), dtype=int), r"shape \(4,\)"),
-    (0, r"shape \(4,\)"),
-    (np.zeros(4), "ints"),
-    (np.array([0, 1, 2, 4]), "invalid action 4"),
-    (np.array([0, -1, 2, 3]), "invalid action -1"),
+@pytest.mark.parametrize("actions, error, match", [
+    (np.zeros(3, dtype=int), ValueError, r"shape \(4,\)"),
+    (np.zeros((4, 1), dtype=int), ValueError, r"shape \(4,\)"),
+    (0, ValueError, r"shape \(4,\)"),
+    (np.zeros(4), TypeError, "actions must be ints, got dtype float64"),
+    (np.ones(4, dtype=bool), TypeError, "actions must be ints, got dtype bool"),
+    (np.array(["0"] * 4), TypeError, "actions must be ints"),
+    (np.array([0, 1, 2, 4]), ValueError, "invalid action 4"),
+    (np.array([0, -1, 2, 3]), ValueError, "invalid action -1"),
 ])
-def test_bad_actions(actions, match):
+def test_bad_actions(actions, error, match):
     worlds = envs.BatchedObjectWorld(4)
     worlds.reset(seed=0)
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises(error, match=match):
         worlds.step(actions)
 
 
-@pytest.mark.parametrize("seed, match", [
-    ([1, 2], "2 entries for 3 worlds"),
-    ([1, 2, -3], "non-negative"),
-    ([1, 2, 3.5], "non-negative ints"),
-    (-1, "non-negative"),
-    ("abc", "non-negative ints, got 'a'"),
-    (2.5, "sequence of 3 ints"),
+@pytest.mark.parametrize("seed, error, match", [
+    ([1, 2], ValueError, "2 entries for 3 worlds"),
+    ([1, 2, -3], ValueError, "non-negative"),
+    ([1, 2, 3.5], TypeError, "non-negative ints, got 3.5"),
+    ([1, 2, True], TypeError, "non-negative ints, got True"),
+    (-1, ValueError, "non-negative"),
+    ("abc", TypeError, "non-negative ints, got 'a'"),
+    (2.5, TypeError, "sequence of 3 ints"),
+    (True, TypeError, "sequence of 3 ints"),
 ])
-def test_bad_seeds(seed, match):
-    with pytest.raises(ValueError, match=match):
+def test_bad_seeds(seed, error, match):
+    with pytest.raises(error, match=match):
         envs.BatchedObjectWorld(3).reset(seed=seed)
 
 
-@pytest.mark.parametrize("n_worlds", [0, -2, 2.0, True])
-def test_bad_n_worlds(n_worlds):
-    with pytest.raises(ValueError, match="n_worlds"):
+@pytest.mark.parametrize("n_worlds", [0, -2])
+def test_too_few_worlds_is_a_value_error(n_worlds):
+    with pytest.raises(ValueError, match="n_worlds must be a positive int"):
+        envs.BatchedObjectWorld(n_worlds)
+
+
+@pytest.mark.parametrize("n_worlds", [2.0, 1.5, True, "2", None])
+def test_n_worlds_not_an_int_is_a_type_error(n_worlds):
+    with pytest.raises(TypeError, match="n_worlds must be a positive int"):
         envs.BatchedObjectWorld(n_worlds)
 
 

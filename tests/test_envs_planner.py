@@ -162,6 +162,8 @@ def test_foe_legs_count_the_fewest_steps_to_swipe_an_enemy(offset):
 @pytest.mark.parametrize("kwargs, error, match", [
     ({"depth": 0}, ValueError, "depth must be >= 1"),
     ({"depth": 2.0}, TypeError, "depth must be an int"),
+    ({"depth": 1.5}, TypeError, "depth must be an int, got 1.5"),
+    ({"route_width": "50"}, TypeError, "route_width must be an int"),
     ({"width": True}, TypeError, "width must be an int"),
     ({"width": -3}, ValueError, "width must be >= 1"),
     ({"route_width": 0}, ValueError, "route_width must be >= 1"),
@@ -185,3 +187,17 @@ def test_act_needs_a_reset_objectworld_mid_episode():
     planner.play(worlds, seed=0)
     with pytest.raises(RuntimeError, match="the episode is over"):
         planner.act(worlds)
+
+
+@pytest.mark.parametrize("make_env", [
+    lambda: gym.make("CartPole-v1"),
+    lambda: gym.vector.SyncVectorEnv([lambda: envs.ObjectWorldEnv()] * 2),
+    lambda: None,
+])
+def test_act_and_play_need_an_objectworld_env(make_env):
+    planner = envs.LookaheadPlanner(depth=1, width=1)
+    env = make_env()
+    with pytest.raises(TypeError, match="plays an ObjectWorldEnv or a BatchedObjectWorld"):
+        planner.act(env)
+    with pytest.raises(TypeError, match="plays an ObjectWorldEnv or a BatchedObjectWorld"):
+        planner.play(env, seed=0)
