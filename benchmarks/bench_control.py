@@ -47,31 +47,16 @@ import numpy as np
 from sklearn.ensemble import ExtraTreesRegressor
 from tqdm.auto import tqdm
 
-from boxtrees import BoxExtraTreesRegressor
-from fqi import FQI, evaluate
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-# Tuned DQN: rl-zoo3 2.9.2, rl_zoo3/hyperparams/dqn.yml (policy "MlpPolicy"; its
-# n_timesteps is replaced by the budget below, the same for every agent).
-DQN_HYPERPARAMS = {
-    "CartPole-v1": {
-        "learning_rate": 2.3e-3, "batch_size": 64, "buffer_size": 100_000,
-        "learning_starts": 1000, "gamma": 0.99, "target_update_interval": 10,
-        "train_freq": 256, "gradient_steps": 128, "exploration_fraction": 0.16,
-        "exploration_final_eps": 0.04, "policy_kwargs": {"net_arch": [256, 256]},
-    },
-    "Acrobot-v1": {
-        "learning_rate": 6.3e-4, "batch_size": 128, "buffer_size": 50_000,
-        "learning_starts": 0, "gamma": 0.99, "target_update_interval": 250,
-        "train_freq": 4, "gradient_steps": -1, "exploration_fraction": 0.12,
-        "exploration_final_eps": 0.1, "policy_kwargs": {"net_arch": [256, 256]},
-    },
-    "MountainCar-v0": {
-        "learning_rate": 4e-3, "batch_size": 128, "buffer_size": 10_000,
-        "learning_starts": 1000, "gamma": 0.98, "target_update_interval": 600,
-        "train_freq": 16, "gradient_steps": 8, "exploration_fraction": 0.2,
-        "exploration_final_eps": 0.07, "policy_kwargs": {"net_arch": [256, 256]},
-    },
-}
+from benchmarks.zoo_hyperparams import ZOO_DQN  # noqa: E402
+from boxtrees import BoxExtraTreesRegressor  # noqa: E402
+from fqi import FQI, evaluate  # noqa: E402
+
+# Tuned DQN: rl-zoo3's settings for each env (benchmarks/zoo_hyperparams.py; policy
+# "MlpPolicy", its n_timesteps replaced by the budget below, the same for every agent).
+DQN_HYPERPARAMS = {env_id: ZOO_DQN[env_id]
+                   for env_id in ("CartPole-v1", "Acrobot-v1", "MountainCar-v0")}
 # Budget (environment steps, rl-zoo3's n_timesteps but CartPole's 50,000 doubled: the goal is
 # FQI solving it within 100,000), solved threshold, and FQI's new transitions per iteration.
 ENVS = {

@@ -30,7 +30,10 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-import envs
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import envs  # noqa: E402
+from benchmarks.calibrate_env import policy_totals  # noqa: E402
 
 GAMES = {"4-actions": {}, "sword": {"sword": True}}
 HUMAN_PER_EPISODE = {"4-actions": 150_000 / 400}  # thesis: about 150,000 over 400 episodes
@@ -44,23 +47,6 @@ def budget(text):
         raise argparse.ArgumentTypeError(f"expected DEPTHxWIDTH with positive ints, e.g. 5x16; "
                                          f"got {text!r}")
     return int(match[1]), int(match[2])
-
-
-def policy_totals(rules, seeds, policy):
-    """Per-episode totals of `policy` ("greedy" or "random", action seed 0) on `seeds`."""
-    worlds = envs.BatchedObjectWorld(len(seeds), **rules)
-    obs, _ = worlds.reset(seed=seeds)
-    greedy = envs.GreedyPolicy(worlds)
-    rng = np.random.default_rng(0)
-    totals = np.zeros(len(seeds))
-    for _ in range(worlds.rules.max_steps):
-        if policy == "greedy":
-            actions = greedy.predict(obs)[0]
-        else:
-            actions = rng.integers(worlds.single_action_space.n, size=len(seeds))
-        obs, rewards, _, _, _ = worlds.step(actions)
-        totals += rewards
-    return totals
 
 
 def planner_run(game, seeds, depth, width):

@@ -27,21 +27,31 @@ VARIANTS = {
 }
 
 
-def total_reward(rules, policy, seed=0):
-    """Total reward of `policy` ("random" or "greedy") over one episode per reference world."""
-    worlds = envs.BatchedObjectWorld(N_WORLDS, **rules)
-    obs, _ = worlds.reset(seed=envs.reference_worlds(N_WORLDS))
-    rng = np.random.default_rng(seed)
+def policy_totals(rules, seeds, policy, seed=0):
+    """Per-episode totals of `policy` ("random", with action seed `seed`, or "greedy", the
+    deterministic `envs.GreedyPolicy`): one episode on the world of each reset seed of
+    `seeds`, under the `envs.WorldRules` keywords `rules`. Also used by bench_planner.py."""
+    if policy not in ("random", "greedy"):
+        raise ValueError(f"policy must be 'random' or 'greedy', got {policy!r}")
+    worlds = envs.BatchedObjectWorld(len(seeds), **rules)
+    obs, _ = worlds.reset(seed=seeds)
     greedy = envs.GreedyPolicy(worlds)
-    total = 0.0
+    rng = np.random.default_rng(seed)
+    totals = np.zeros(len(seeds))
     for _ in range(worlds.rules.max_steps):
-        if policy == "random":
-            actions = rng.integers(worlds.single_action_space.n, size=N_WORLDS)
-        else:
+        if policy == "greedy":
             actions = greedy.predict(obs)[0]
+        else:
+            actions = rng.integers(worlds.single_action_space.n, size=len(seeds))
         obs, rewards, _, _, _ = worlds.step(actions)
-        total += rewards.sum()
-    return total
+        totals += rewards
+    return totals
+
+
+def total_reward(rules, policy, seed=0):
+    """Total reward of `policy` (as in `policy_totals`) over one episode per reference
+    world."""
+    return policy_totals(rules, envs.reference_worlds(N_WORLDS), policy, seed).sum()
 
 
 def main():

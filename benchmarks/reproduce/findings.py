@@ -212,7 +212,8 @@ class NearRandom(_Rule):
         s, ref = stats[self.label], stats[self.reference]
         holds = abs(s.score - s.random_reward) < abs(ref.score - s.score)
         return Verdict(self.claim, holds,
-                       f"{self.label} {_fmt(s.score)}, random policy {_fmt(s.random_reward)}, "
+                       f"{self.label} {_fmt(s.score)}, random policy on its runs' seeds "
+                       f"{_fmt(s.random_reward)}, "
                        f"{self.reference} {_fmt(ref.score)}")
 
 

@@ -5,6 +5,7 @@ import math
 import time
 from pathlib import Path
 
+from .budgets import EVAL_REFERENCE_STEPS
 from .plots import ACTION_NAMES, TYPE_NAMES, plot_experiment
 from .registry import EXPERIMENTS, REGISTRY
 from .runner import gather, setting_units
@@ -88,6 +89,8 @@ def _header(experiments, budget, seeds, elapsed, n_run):
     timing = "" if elapsed is None else (f" This invocation ran {n_run} run(s) in "
                                          f"{elapsed / 60:.1f} min ({ran}).")
     dqn_steps = budget.dqn_steps or budget.iterations * budget.samples
+    rescaled = ("" if budget.eval_steps == EVAL_REFERENCE_STEPS
+                else " (fewer than the thesis: rewards rescaled)")
     return (
         f"# Reproducing the thesis: report ({budget.name} budget)\n\n"
         f"Written by `python benchmarks/run_all.py` on {time.strftime('%Y-%m-%d %H:%M')}."
@@ -98,9 +101,9 @@ def _header(experiments, budget, seeds, elapsed, n_run):
         f"{'' if seeds is None else f' (this invocation: seeds {list(seeds)})'}, "
         f"{budget.iterations} iterations x {budget.samples:,} samples (x2 for the sword game), "
         f"greedy evaluation over {budget.eval_steps:,} steps on the fixed reference worlds"
-        f"{'' if budget.eval_steps == 20_000 else ' (fewer than the thesis: rewards rescaled)'}"
-        f"; every reward is per 20,000 steps as in the thesis. RMSE: {budget.rmse_folds}-fold "
-        f"CV on {budget.rmse_samples:,} random-policy samples. DQN: {dqn_steps:,} env steps."
+        f"{rescaled}; every reward is per {EVAL_REFERENCE_STEPS:,} steps as in the thesis. "
+        f"RMSE: {budget.rmse_folds}-fold CV on {budget.rmse_samples:,} random-policy samples. "
+        f"DQN: {dqn_steps:,} env steps."
         + ("" if budget.max_trees is None else
            f" Forests capped at {budget.max_trees} trees, {budget.max_tests} tests.")
         + "".join(f" At this budget `{name}` runs with "

@@ -18,6 +18,7 @@ import envs
 import fqi
 
 from . import units as _units
+from .budgets import EVAL_REFERENCE_STEPS
 from .cache import (Checkpoint, attempts, load_unit, mark_attempt, save_unit, set_attempts,
                     unit_path)
 from .registry import resolve
@@ -46,9 +47,9 @@ class Unit:
         """Rough run time in seconds on 2 free cores (measured at the quick budget), for
         the progress bar's ETA."""
         p = self.params
-        if p["kind"] == "policy":  # the planner: about a minute on the 4-action game
+        if p["kind"] == "policy":  # the planner: about a minute per 20,000 steps (4 actions)
             actions = 2.0 if p["env_id"] == "ObjectWorldSword-v0" else 1.0
-            return (60.0 * actions ** 2 * budget.eval_steps / 20_000
+            return (60.0 * actions ** 2 * budget.eval_steps / EVAL_REFERENCE_STEPS
                     if p["policy"] == "planner" else 1.0)
         if p["kind"] in ("dqn", "sb3"):  # DQN's updates through the set encoder cost most
             objects = 4.0 if p.get("observation") == "objects" and p.get("algo") != "PPO" \

@@ -20,8 +20,8 @@ from fqi import (FQI, GridObservation, RandomPolicy, evaluate, make_box_forest, 
 __all__ = ["run_unit", "make_agent", "GAMMA"]
 
 # Discount factor of every FQI and DQN run (the thesis does not state one; 0.5 scored best
-# in the measured comparison of README section "fqi"). Pinned here so a changed library
-# default cannot silently change cached results.
+# in the measured comparison of docs/fqi.md, "Discount factor"). Pinned here so a changed
+# library default cannot silently change cached results.
 GAMMA = 0.5
 _TOP_TESTS = 4  # boxes drawn per action and object type in the attention figure
 _ATTENTION_CANDIDATES = 40  # reference worlds searched for a busy view to draw on
