@@ -227,8 +227,8 @@ class FQI:
         Builds the training vector env and the evaluation one (from `eval_env`, else from
         the constructor's `eval_env`, else from `env`), then tries the env (a reset and a
         step) and the regressor (fitted on those observations). Collection starts new
-        episodes. The vector envs the agent built for its previous env are closed (a vector
-        env given as it is stays open: it is the caller's).
+        episodes. The previous envs are left as they are (as stable-baselines3 does); a call
+        that fails closes the vector envs it built.
 
         Parameters
         ----------
@@ -264,9 +264,6 @@ class FQI:
             _close_built(vector, env)
             _close_built(eval_vector, eval_env)
             raise
-        if getattr(self, "_env", None) is not None:  # not at construction
-            _close_built(self._env, self.env)
-            _close_built(self._eval_env, self.eval_env)
         self.env, self.eval_env = env, eval_env
         self._env, self._eval_env = vector, eval_vector
         self.observation_space, self.action_space = observation_space, action_space

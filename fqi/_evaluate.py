@@ -125,7 +125,8 @@ def evaluate(policy, env, n_episodes=None, seeds=None):
         stable-baselines3 model on a ``Box`` env): one int action in ``[0, n_actions)`` per
         env (else a ValueError).
     env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable
-        As for `FQI`. Its episodes must end (a time limit).
+        As for `FQI`. Its episodes must end (a time limit). A vector env is played as it is
+        and left open; the vector env built from any other form is closed at the end.
     n_episodes : int, default=None
         Number of episodes: ``len(seeds)`` when seeds are given, else 10.
     seeds : sequence of int, default=None

@@ -413,7 +413,14 @@ class Closing(Countdown):
         Closing.closed += 1
 
 
-def test_the_vector_envs_the_agent_builds_are_closed_and_given_ones_are_not():
+class ClosingBroken(Closing):
+    """A `Closing` that raises in `step`."""
+
+    def step(self, action):
+        raise RuntimeError("the simulator lost its connection")
+
+
+def test_evaluate_and_a_failed_set_env_close_the_envs_they_build_and_no_other():
     Closing.closed = 0
     policy = RandomPolicy(Closing(), seed=0)
     evaluate(policy, Closing, seeds=[0, 1, 2])
@@ -423,15 +430,17 @@ def test_the_vector_envs_the_agent_builds_are_closed_and_given_ones_are_not():
     assert Closing.closed == 3 and not given.closed
     agent = FQI(classic_forest(), Closing, n_envs=2, samples_per_iteration=20,
                 eval_episodes=2)
-    assert Closing.closed == 3  # the agent's own: training and evaluation
+    assert Closing.closed == 3  # the agent's training and evaluation envs stay open
+    old = agent.get_env()
     agent.set_env(given, eval_env=Closing)
-    assert Closing.closed == 7 and not given.closed  # 2 training + 2 evaluation envs
-    agent.set_env(Closing)
-    assert Closing.closed == 9 and not given.closed  # the evaluation's, not the given ones
-    kept = agent.get_env()
+    agent.set_env(agent.get_env(), eval_env=Closing)  # its own env again
+    assert Closing.closed == 3 and not given.closed and not old.closed  # left as they are
     with pytest.raises(ValueError, match="the agent was made for"):
         agent.set_env(Coins)
-    assert Closing.closed == 9 and agent.get_env() is kept and not kept.closed
+    assert agent.get_env() is given and not given.closed
+    with pytest.raises(RuntimeError, match="step"):
+        agent.set_env(ClosingBroken)  # builds 2 training + 2 evaluation envs, then fails
+    assert Closing.closed == 7 and agent.get_env() is given and not given.closed
     agent.learn(1)
 
 
