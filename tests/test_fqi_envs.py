@@ -166,7 +166,8 @@ class AnyTypes(Coins):
 
     def __init__(self):
         super().__init__()
-        row = spaces.Box(np.array([-5, -5, 0]), np.array([5, 5, np.inf]), dtype=np.float32)
+        row = spaces.Box(np.array([-5, -5, 0], dtype=np.float32),
+                         np.array([5, 5, np.inf], dtype=np.float32))
         self.observation_space = spaces.Sequence(row, stack=True)
 
 
