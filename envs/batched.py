@@ -8,10 +8,10 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from ._engine import _Engine
-from ._rules import WorldRules
+from ._rules import WorldRules, _check_int
 from .object_world import (
-    _RENDER_MODES, _can_render, _check_render, _layout_from_options, _object_space,
-    _OwnEpisodeLimit, _render_frame,
+    _RENDER_MODES, ObjectWorldEnv, _can_render, _check_render, _layout_from_options,
+    _object_space, _OwnEpisodeLimit, _render_frame,
 )
 
 __all__ = ["BatchedObjectWorld", "RaggedBatch"]
@@ -200,10 +200,7 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
                 "render_fps": 8}
 
     def __init__(self, n_worlds, render_mode=None, render_view="world", **rules):
-        if not isinstance(n_worlds, Integral) or isinstance(n_worlds, bool):
-            raise TypeError(f"n_worlds must be a positive int, got {n_worlds!r}")
-        if n_worlds < 1:
-            raise ValueError(f"n_worlds must be a positive int, got {n_worlds!r}")
+        n_worlds = _check_int("n_worlds", n_worlds, 1)
         self.rules = WorldRules(**rules)
         _check_render(render_mode, render_view)
         self.render_mode = render_mode
@@ -336,3 +333,14 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
             bad = array[(array < 0) | (array >= n_actions)][0]
             raise ValueError(f"invalid action {bad}: actions must lie in [0, {n_actions})")
         return array.astype(np.intp, copy=False)
+
+
+def _unwrapped_world(env, player):
+    """`env` unwrapped, which must be an `ObjectWorldEnv` or a `BatchedObjectWorld`: a
+    TypeError naming `player` otherwise."""
+    base = getattr(env, "unwrapped", env)
+    if not isinstance(base, (ObjectWorldEnv, BatchedObjectWorld)):
+        raise TypeError(f"{player} plays an ObjectWorldEnv or a BatchedObjectWorld (possibly "
+                        f"wrapped), got {type(env).__name__}; for many worlds use "
+                        f"envs.BatchedObjectWorld(n) or gymnasium.make_vec(id, num_envs=n)")
+    return base

@@ -28,8 +28,7 @@ from numbers import Real
 import numpy as np
 
 from ._rules import _REWARD_MONEY, _REWARD_SWIPE_ONE, MONEY, _check_int
-from .batched import BatchedObjectWorld
-from .object_world import ObjectWorldEnv
+from .batched import BatchedObjectWorld, _unwrapped_world
 
 __all__ = ["LookaheadPlanner"]
 
@@ -378,10 +377,7 @@ class LookaheadPlanner:
     @staticmethod
     def _unwrap(env, reset=True):
         """`env` unwrapped and its engine, checked to be reset and mid-episode if `reset`."""
-        base = getattr(env, "unwrapped", env)
-        if not isinstance(base, (ObjectWorldEnv, BatchedObjectWorld)):
-            raise TypeError("the planner plays an ObjectWorldEnv or a BatchedObjectWorld "
-                            f"(possibly wrapped), got {type(env).__name__}")
+        base = _unwrapped_world(env, "the planner")
         engine = base._engine
         if reset and engine.observation is None:
             raise RuntimeError("call env.reset() before planning")

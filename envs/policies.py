@@ -2,8 +2,7 @@
 import numpy as np
 
 from ._rules import _DIRECTIONS, ENEMY, MONEY, WALL
-from .batched import BatchedObjectWorld, _check_offsets
-from .object_world import ObjectWorldEnv
+from .batched import _check_offsets, _unwrapped_world
 
 __all__ = ["GreedyPolicy"]
 
@@ -76,13 +75,7 @@ class GreedyPolicy:
     """
 
     def __init__(self, env):
-        base = getattr(env, "unwrapped", None)
-        if not isinstance(base, (ObjectWorldEnv, BatchedObjectWorld)):
-            raise TypeError(
-                "GreedyPolicy plays an ObjectWorldEnv or a BatchedObjectWorld (possibly "
-                f"wrapped), got {type(env).__name__}; for many worlds use "
-                "envs.BatchedObjectWorld(n) or gymnasium.make_vec(id, num_envs=n)")
-        self.rules = base.rules
+        self.rules = _unwrapped_world(env, "GreedyPolicy").rules
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         """Actions for one observation or a batch (stable-baselines3 signature).
