@@ -182,14 +182,20 @@ class ObjectSets:
             raise ValueError(
                 f"X must be a 2D feature matrix of shape (n_samples, n_features); got shape {X.shape}"
             )
-        n_samples, n_features = X.shape
-        if n_features > _MAX_TYPE:
-            raise ValueError(f"X has {n_features} features; at most {_MAX_TYPE} are supported")
         if X.dtype.kind == "f" and X.size:
             if not np.isfinite(X).all():
                 raise ValueError("X contains NaN or infinite values")
             if X.dtype.itemsize > 4 and np.abs(X).max() > _FLOAT32_MAX:
                 raise ValueError("X has values too large for float32 (|value| > 3.4e38)")
+        return cls._from_validated_features(X)
+
+    @classmethod
+    def _from_validated_features(cls, X):
+        """`from_features` of a real, finite 2D matrix (the estimators' ``validate_data``
+        has checked it: predict-time batches are not scanned twice)."""
+        n_samples, n_features = X.shape
+        if n_features > _MAX_TYPE:
+            raise ValueError(f"X has {n_features} features; at most {_MAX_TYPE} are supported")
         data = np.zeros((n_samples * n_features, 3), dtype=np.float32)
         data[:, 0] = X.ravel()
         data[:, 2] = np.tile(np.arange(n_features, dtype=np.float32), n_samples)
@@ -445,7 +451,7 @@ class ObjectInputMixin:
                                      multi_output=True, y_numeric=self._y_numeric)
             else:
                 X = validate_data(self, X, reset=reset, dtype=np.float32)
-            sets = X if matrix else ObjectSets.from_features(X)
+            sets = X if matrix else ObjectSets._from_validated_features(X)
         else:
             sets = as_object_sets(X)
             if reset:
