@@ -65,8 +65,8 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
     """Parameters, fitting and traversal shared by a box-test tree and a forest of them.
 
     Fitting sets ``types_`` (the sorted type ids seen, or the column indices of a feature
-    matrix), ``n_types_``, ``bounds_`` and the private ``_packed`` form the traversal reads
-    (rebuilt, and so validated again, when unpickled).
+    matrix), ``n_types_``, ``n_attributes_``, ``column_groups_``, ``bounds_`` and the private
+    ``_packed`` form the traversal reads (rebuilt, and so validated again, when unpickled).
     """
 
     _parameter_constraints = {
@@ -81,6 +81,8 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         "refine_tests": ["boolean"],
         "max_depth": [Interval(Integral, 0, _INT32_MAX, closed="both"), None],
         "view_bounds": ["array-like", Interval(Real, 0, None, closed="neither"), None],
+        "column_groups": [list, tuple, None],
+        "relative_width": ["boolean"],
     }
 
     def _fit_trees(self, X, y, sample_weight, seeds, n_jobs=None, verbose=0, bootstrap=False):
@@ -101,7 +103,7 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         objects = _TrainingObjects(self, sets)
         split = self.min_samples_split
         params = _TreeParams(
-            test_type=self.test_type, test_width=float(self.test_width), n_tests=self.n_tests,
+            test_type=self.test_type, n_tests=self.n_tests,
             min_samples_split=split if isinstance(split, Integral) else max(2, ceil(split * len(sets))),
             max_depth=-1 if self.max_depth is None else self.max_depth,
             max_retries=self.max_retries, refine_tests=bool(self.refine_tests),
@@ -110,7 +112,8 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             delayed(_grow_tree)(objects, y, sample_weight, params, int(seed), bootstrap)
             for seed in seeds
         )
-        return [BoxTree.from_positions(self._node_arrays(arrays), self.types_) for arrays in trees]
+        return [BoxTree.from_builder(self._node_arrays(arrays), self.types_, self.column_groups_,
+                                     self.n_attributes_) for arrays in trees]
 
     def _node_arrays(self, arrays):
         """The builder's node arrays as the estimator's trees keep them."""
@@ -199,7 +202,6 @@ class _TreeParams:
     """How one tree is grown (see ``boxtrees._builder.build_tree``)."""
 
     test_type: str
-    test_width: float
     n_tests: int
     min_samples_split: int
     max_depth: int
@@ -327,24 +329,53 @@ class ClassificationTargets(ClassifierMixin):
 class _TrainingObjects:
     """The training objects indexed for the tree builder.
 
-    Objects of sets are grouped into segments, one per (type position, y band), and sorted
-    by x in each; ``sample_of`` is the sample of each object. A feature matrix is passed as it
-    is, as ``columns`` (the builder reads it in place). Sets the estimator's ``types_``,
-    ``n_types_`` and ``bounds_``.
+    A test's box spans the columns of one column group: its x column, and its y column if
+    it has two. Every group indexes all the objects of sets, in segments, one per (group,
+    type position, y band), sorted by x in each; ``sample_of`` is the sample of each object.
+    A feature matrix is passed as it is, as ``columns`` (the builder reads it in place; its
+    values are one attribute, one group). Sets the estimator's ``types_``, ``n_types_``,
+    ``column_groups_`` and ``bounds_``.
     """
 
     def __init__(self, estimator, sets):
         features = estimator._fitted_on_features
-        if features:          # ``sets`` is the feature matrix: values are x, y is 0
+        d = estimator.n_attributes_
+        if features:          # ``sets`` is the feature matrix: each column is one attribute
             estimator.types_ = np.arange(estimator.n_features_in_)
-            x, y = sets, np.zeros(1)
+            low, high = sets.min(axis=0), sets.max(axis=0)
         else:
-            x, y = sets.data[:, 0], sets.data[:, 1]
-            estimator.types_, position = np.unique(sets.data[:, 2].astype(np.intp), return_inverse=True)
+            data = sets.data
+            estimator.types_, position = np.unique(data[:, d].astype(np.intp), return_inverse=True)
             if not len(estimator.types_):
                 estimator.types_ = np.zeros(1, dtype=np.intp)
-        estimator.n_types_ = len(estimator.types_)
-        estimator.bounds_ = self.bounds = _sampling_region(estimator, x, y)
+            low, high = (data[:, :d].min(axis=0), data[:, :d].max(axis=0)) if len(data) else \
+                (np.zeros(d), np.ones(d))
+        estimator.n_types_ = n_types = len(estimator.types_)
+        estimator.column_groups_ = groups = _column_groups(estimator.column_groups, d)
+        if estimator.view_bounds is not None:
+            region = np.tile(check_view_bounds(estimator.view_bounds, d), (n_types, 1))
+        elif features:        # each column's own range
+            region = np.column_stack([low, high])
+        else:
+            region = np.tile(np.column_stack([low, high]).ravel(), (n_types, 1))
+        estimator.bounds_ = region.astype(np.float32)
+        width = float(estimator.test_width)
+        if estimator.relative_width:
+            half = width * (region[:, 1::2] - region[:, 0::2])      # (n_types, d)
+        else:
+            half = np.full((n_types, d), width)
+        # per (group, type): the region of the group's x and y columns, and the half-widths
+        self.n_groups = len(groups)
+        self.bounds = np.empty((self.n_groups * n_types, 4), dtype=np.float32)
+        self.half_widths = np.zeros((self.n_groups * n_types, 2))
+        for g, columns in enumerate(groups):
+            mine = slice(g * n_types, (g + 1) * n_types)
+            x = columns[0]
+            y = columns[1] if len(columns) == 2 else None
+            self.bounds[mine, :2] = region[:, 2 * x:2 * x + 2]
+            self.bounds[mine, 2:] = region[:, 2 * y:2 * y + 2] if y is not None else [-np.inf, np.inf]
+            self.half_widths[mine, 0] = half[:, x]
+            self.half_widths[mine, 1] = half[:, y] if y is not None else 0.0
         self.local_x = features and estimator.view_bounds is None
         self.columns = None
         if features:
@@ -355,47 +386,78 @@ class _TrainingObjects:
             self._index_objects(estimator, sets, position)
 
     def _index_objects(self, estimator, sets, position):
-        data = sets.data
-        self.band_edges = _band_edges(estimator)
-        n_bands = len(self.band_edges) - 1
-        bands = np.searchsorted(self.band_edges[1:-1], data[:, 1], side="right")
-        segments = position * n_bands + bands
-        order = np.lexsort((data[:, 0], segments))
-        self.x = np.ascontiguousarray(data[order, 0])
-        self.y = np.ascontiguousarray(data[order, 1])
-        self.sample_of = sets.sample_index()[order].astype(np.int32)
+        data, groups, n_types = sets.data, estimator.column_groups_, estimator.n_types_
+        edges = [_band_edges(estimator, self.bounds[g * n_types], self.half_widths[g * n_types, 1])
+                 for g in range(len(groups))]
+        n_bands = max(len(e) for e in edges) - 1
+        # every group has n_bands bands; the last ones of a group with fewer are empty
+        self.band_edges = np.array([np.pad(e, (0, n_bands + 1 - len(e)), constant_values=np.inf)
+                                    for e in edges])
+        sample = sets.sample_index().astype(np.int32)
+        xs, ys, sample_of, segments = [], [], [], []
+        for g, columns in enumerate(groups):
+            x = data[:, columns[0]]
+            y = data[:, columns[1]] if len(columns) == 2 else np.zeros_like(x)
+            bands = np.searchsorted(edges[g][1:-1], y, side="right")
+            segment = (g * n_types + position) * n_bands + bands
+            order = np.lexsort((x, segment))
+            xs.append(x[order])
+            ys.append(y[order])
+            sample_of.append(sample[order])
+            segments.append(segment[order])
+        self.x = np.ascontiguousarray(np.concatenate(xs))
+        self.y = np.ascontiguousarray(np.concatenate(ys))
+        self.sample_of = np.concatenate(sample_of)
         self.segment_ptr = np.searchsorted(
-            segments[order], np.arange(estimator.n_types_ * n_bands + 1)
+            np.concatenate(segments), np.arange(len(groups) * n_types * n_bands + 1)
         ).astype(np.intp)
 
 
-def _sampling_region(estimator, x, y):
-    """Region ``(xmin, xmax, ymin, ymax)`` in which tests of each type are drawn, given the
-    coordinates of the training objects."""
-    if estimator.view_bounds is not None:
-        region = check_view_bounds(estimator.view_bounds)
-    elif x.size:
-        region = np.array([x.min(), x.max(), y.min(), y.max()])
-    else:
-        region = np.array([0.0, 1.0, 0.0, 1.0])
-    bounds = np.tile(region, (estimator.n_types_, 1))
-    if estimator._fitted_on_features:
-        bounds[:, 2:] = [-np.inf, np.inf]
-    return np.ascontiguousarray(bounds, dtype=np.float32)
+def _column_groups(column_groups, n_attributes):
+    """The column groups a test's box may span, validated: ``column_groups`` or, for None,
+    the first two attributes together and every other one alone."""
+    if column_groups is None:
+        if n_attributes == 1:
+            return ((0,),)
+        return ((0, 1),) + tuple((c,) for c in range(2, n_attributes))
+    groups = []
+    for group in column_groups:
+        group = (group,) if isinstance(group, Integral) else group
+        try:
+            group = tuple(group)
+        except TypeError:
+            group = None
+        if (not group or len(group) > 2
+                or not all(isinstance(c, Integral) and 0 <= c < n_attributes for c in group)
+                or len(set(group)) != len(group)):
+            raise ValueError(
+                f"column_groups must be a non-empty sequence of groups of one or two distinct "
+                f"attribute indices in [0, {n_attributes}) (the objects have {n_attributes} "
+                f"attributes before their type); got {column_groups!r}"
+            )
+        groups.append(tuple(int(c) for c in group))
+    if not groups:
+        raise ValueError("column_groups must name at least one group of columns; got "
+                         f"{column_groups!r}")
+    return tuple(groups)
 
 
-def _band_edges(estimator):
-    """Edges of the y bands that index the training objects (an internal speed-up).
+def _band_edges(estimator, bounds, y_half_width):
+    """Edges of the y bands that index the training objects of one column group (an internal
+    speed-up), from its region ``bounds`` ``(xmin, xmax, ymin, ymax)``.
 
     Bands about twice as tall as a fixed or bounded box (measured best) let a test skip most
-    objects of its type; wholly covered bands need no y comparison.
+    objects of its type; wholly covered bands need no y test. A group of one column (an
+    unbounded y extent) has one band.
     """
-    bounds = estimator.bounds_
+    y0, y1 = float(bounds[2]), float(bounds[3])
+    if not np.isfinite(y0):
+        return np.array([-np.inf, np.inf])
     if estimator.test_type in ("fixed", "bounded"):
-        height = float(bounds[0, 3]) - float(bounds[0, 2])
-        n_bands = int(np.clip(np.ceil(height / (4 * estimator.test_width)), 1, _MAX_BANDS))
+        height = y1 - y0
+        n_bands = int(np.clip(np.ceil(height / (4 * y_half_width)), 1, _MAX_BANDS)) \
+            if y_half_width > 0 else _MAX_BANDS
     else:
         n_bands = _DEFAULT_BANDS
-    y0, y1 = float(bounds[0, 2]), float(bounds[0, 3])
     inner = y0 + (y1 - y0) * np.arange(1, n_bands) / n_bands
     return np.concatenate([[-np.inf], inner, [np.inf]])

@@ -48,6 +48,7 @@ cdef double FEATURE_THRESHOLD = 1e-7
 
 cdef struct BoxTest:
     intp_t object_type
+    intp_t group          # the column group its box spans (x, then y: see _TrainingObjects)
     coord_t xmin
     coord_t xmax
     coord_t ymin
@@ -60,7 +61,8 @@ cdef struct Node:         # one node of a growing tree; its values are kept besi
     intp_t children_left
     intp_t children_right
     int32 object_type     # a position in the forest's types
-    coord_t box[4]
+    int32 group           # a position in the forest's column groups
+    coord_t box[4]        # over the group's columns
     int32 threshold
     float64_t impurity
     intp_t n_node_samples
@@ -191,15 +193,18 @@ cdef class _Splitter:
     # segment g of the current node is lo[g]:hi[g] (object sets; a feature matrix has none)
     cdef intp_t* lo
     cdef intp_t* hi
-    cdef double* region              # per type of the current node: x0, x1, y0, y1 of its tests
+    # per (group, type), at ``group * n_types + type``: x0, x1, y0, y1 of its tests in the
+    # current node, and the half-widths along x and y of fixed and bounded boxes
+    cdef double* region
+    cdef const double* half
     cdef intp_t* type_size           # per type: the current node's number of objects
     cdef intp_t* live                # the types tests are drawn on in the current node
     cdef intp_t n_live
     cdef const coord_t[:, ::1] bounds
     cdef intp_t n_samples
     cdef intp_t n_types
+    cdef intp_t n_groups
     cdef int kind
-    cdef double width
     cdef intp_t n_tests
     cdef intp_t max_retries
     cdef uint64 rng
@@ -214,6 +219,10 @@ cdef class _Splitter:
                   uint64 seed):
         cdef const coord_t[:, ::1] bounds = objects.bounds
         cdef intp_t n_samples = len(target), n_segments = segment_ptr.shape[0] - 1
+        cdef intp_t n_groups = objects.n_groups, n_types = bounds.shape[0] // n_groups
+        half = np.array(objects.half_widths, dtype=np.float64)
+        if half.shape != (bounds.shape[0], 2):
+            raise ValueError("half_widths must be (n_groups * n_types, 2), as bounds")
         self._keep_alive = []
         self.order = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
         self.new_id = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
@@ -232,14 +241,15 @@ cdef class _Splitter:
         self.lo = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
         self.hi = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
         self.region = <double*>self._own(np.array(bounds, dtype=np.float64))
-        self.type_size = <intp_t*>self._own(np.empty(bounds.shape[0], dtype=np.intp))
-        self.live = <intp_t*>self._own(np.arange(bounds.shape[0], dtype=np.intp))
-        self.n_live = bounds.shape[0]
+        self.half = <const double*>self._own(half)
+        self.type_size = <intp_t*>self._own(np.empty(n_types, dtype=np.intp))
+        self.live = <intp_t*>self._own(np.arange(n_types, dtype=np.intp))
+        self.n_live = n_types
         self.bounds = bounds
         self.n_samples = n_samples
-        self.n_types = bounds.shape[0]
+        self.n_types = n_types
+        self.n_groups = n_groups
         self.kind = TEST_KINDS[params.test_type]
-        self.width = params.test_width
         self.n_tests = params.n_tests
         self.max_retries = params.max_retries
         self.refine = params.refine_tests
@@ -274,11 +284,14 @@ cdef class _Splitter:
     cdef bint sample_test(self, BoxTest* t) noexcept nogil:
         """Draw a test; False when its type has no object in the node (it cannot split)."""
         cdef intp_t ty = self.live[rand_int(&self.rng, self.n_live)]
-        cdef const double* r = self.region + 4 * ty
+        cdef intp_t group = rand_int(&self.rng, self.n_groups) if self.n_groups > 1 else 0
+        cdef const double* r = self.region + 4 * (group * self.n_types + ty)
+        cdef const double* half = self.half + 2 * (group * self.n_types + ty)
         cdef double x0 = r[0], x1 = r[1], y0 = r[2], y1 = r[3]
-        cdef bint one_dim = y0 == -INFINITY     # feature-matrix columns: the y extent is unbounded
+        cdef bint one_dim = y0 == -INFINITY     # a group of one column: the y extent is unbounded
         cdef double a, b, h
         t.object_type = ty
+        t.group = group
         if self.type_size[ty] == 0:
             return False
         t.ymin = -INFINITY
@@ -299,14 +312,15 @@ cdef class _Splitter:
             else:
                 t.ymax = rand_uniform(&self.rng, y0, y1)
         else:
-            h = self.width
+            h = half[0]
             if self.kind == BOUNDED:
-                h *= 1.0 - rand_unit(&self.rng)     # (0, width]
+                h *= 1.0 - rand_unit(&self.rng)     # (0, half-width]
             a = rand_uniform(&self.rng, x0, x1)
             t.xmin, t.xmax = a - h, a + h
             if not one_dim:
+                h = half[1]
                 if self.kind == BOUNDED:
-                    h = self.width * (1.0 - rand_unit(&self.rng))
+                    h *= 1.0 - rand_unit(&self.rng)
                 a = rand_uniform(&self.rng, y0, y1)
                 t.ymin, t.ymax = a - h, a + h
         return True
@@ -409,7 +423,8 @@ cdef class _Splitter:
         if p > 0:
             outer = self.candidates[m - p].first
         else:                    # nothing outside: keep the old edge if it is out there
-            outer = old if old > inner else _key(self.region[4 * best.object_type + side], side)
+            outer = old if old > inner else _key(
+                self.region[4 * (best.group * self.n_types + best.object_type) + side], side)
             if not outer > inner:
                 outer = nextafterf(inner, INFINITY)
         edge = <coord_t>((<double>inner + <double>outer) / 2)
@@ -480,8 +495,9 @@ cdef class _Splitter:
 @cython.final
 cdef class _ObjectSplitter(_Splitter):
     """The splitter of object sets: the tree's own copy of the segment buffers, which split()
-    partitions, and the per-sample counts of a test. Segment ``g = type * n_bands + band``
-    of the current node is ``lo[g]:hi[g]``."""
+    partitions, and the per-sample counts of a test. Segment ``g = (group * n_types + type)
+    * n_bands + band`` of the current node is ``lo[g]:hi[g]``: every column group indexes
+    all the objects, by its own x and y columns."""
     cdef coord_t* xs
     cdef coord_t* ys
     cdef int32* sid
@@ -491,7 +507,7 @@ cdef class _ObjectSplitter(_Splitter):
     cdef int32* strip                # sample ids of the objects of a strip inside the box
     cdef int32* hits
     cdef intp_t n_hit                # of the test being applied by split()
-    cdef const float64_t* edges      # band edges, n_bands + 1, from -inf to +inf
+    cdef const float64_t* edges      # per group: its band edges, n_bands + 1, -inf to +inf
     cdef intp_t n_bands
 
     def __cinit__(self, objects, const intp_t[::1] segment_ptr, target, weight, params,
@@ -518,13 +534,16 @@ cdef class _ObjectSplitter(_Splitter):
         # knows whether the sample is new, so with every sample hit it writes one past them
         self.hits = <int32*>self._own(np.empty(n_samples + 1, dtype=np.int32))
         edges = np.array(objects.band_edges, dtype=np.float64)
-        if edges.ndim != 1 or (edges.shape[0] - 1) * self.n_types != segment_ptr.shape[0] - 1:
-            raise ValueError("segment_ptr must have n_types * n_bands + 1 entries")
+        if (edges.ndim != 2 or edges.shape[0] != self.n_groups
+                or (edges.shape[1] - 1) * self.n_types * self.n_groups != segment_ptr.shape[0] - 1):
+            raise ValueError("band_edges must be (n_groups, n_bands + 1) and segment_ptr must "
+                             "have n_groups * n_types * n_bands + 1 entries")
         self.edges = <const float64_t*>self._own(edges)
-        self.n_bands = edges.shape[0] - 1
+        self.n_bands = edges.shape[1] - 1
 
     cdef void _find_regions(self) noexcept nogil:
-        """Tests are drawn on every type of the training set, in its region."""
+        """Tests are drawn on every type of the training set, in its region (every group
+        indexes every object: the first group's segments are counted)."""
         cdef intp_t ty, g
         for ty in range(self.n_types):
             self.type_size[ty] = 0
@@ -544,15 +563,16 @@ cdef class _ObjectSplitter(_Splitter):
         cdef int32* strip = self.strip
         cdef int32* counts = self.counts
         cdef int32* hits = self.hits
-        cdef const float64_t* edges = self.edges
+        cdef const float64_t* edges = self.edges + t.group * (self.n_bands + 1)
         cdef coord_t ymin = t.ymin, ymax = t.ymax
         cdef intp_t band, g, a, e, j, n, n_hit = 0, first_band = 0, end_band = 0
+        cdef intp_t first_segment = (t.group * self.n_types + t.object_type) * self.n_bands
         cdef int32 s, c, top = 0
         for band in range(self.n_bands):         # the bands the box overlaps, without branches
             first_band += edges[band + 1] <= ymin
             end_band += edges[band] < ymax
         for band in range(first_band, end_band):
-            g = t.object_type * self.n_bands + band
+            g = first_segment + band
             if self.hi[g] - self.lo[g] <= SHORT_SEGMENT:
                 # a short segment is tested whole, x and y at once: no search
                 n = _kernels.compact_box(xs + self.lo[g], ys + self.lo[g], sid + self.lo[g],
@@ -646,8 +666,9 @@ cdef class _ObjectSplitter(_Splitter):
         cdef intp_t g, j, m = 0
         cdef coord_t x, y
         cdef bint inside
+        cdef intp_t first_segment = (t.group * self.n_types + t.object_type) * self.n_bands
         self.candidates.resize(self.type_size[t.object_type])
-        for g in range(t.object_type * self.n_bands, (t.object_type + 1) * self.n_bands):
+        for g in range(first_segment, first_segment + self.n_bands):
             for j in range(self.lo[g], self.hi[g]):
                 x, y = self.xs[j], self.ys[j]
                 inside = ((side == 0 or t.xmin < x) and (side == 1 or x < t.xmax)
@@ -704,7 +725,7 @@ cdef class _ObjectSplitter(_Splitter):
 
     cdef void _move_objects(self, int32 mid, intp_t* right_lo) noexcept nogil:
         cdef intp_t g, j
-        for g in range(self.n_types * self.n_bands):
+        for g in range(self.n_groups * self.n_types * self.n_bands):
             right_lo[g] = self.lo[g] + _kernels.partition(
                 self.xs + self.lo[g], self.ys + self.lo[g], self.sid + self.lo[g],
                 self.hi[g] - self.lo[g], self.new_id, mid, self.tmp_x, self.tmp_y,
@@ -955,6 +976,7 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, vector[float64_t]* valu
                                    values.data() + node_id * n_outputs, &node.impurity)
         node.children_left = node.children_right = TREE_LEAF
         node.object_type = node.threshold = TREE_UNDEFINED
+        node.group = 0
         node.box[0] = node.box[1] = node.box[2] = node.box[3] = 0.0
         node.n_node_samples = rec.end - rec.start
         node.weighted_n_node_samples = w
@@ -975,6 +997,7 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, vector[float64_t]* valu
         if mid == rec.start or mid == rec.end:   # (never: every test kept splits the node)
             continue
         nodes[0][node_id].object_type = <int32>best.object_type
+        nodes[0][node_id].group = <int32>best.group
         nodes[0][node_id].box[0] = best.xmin
         nodes[0][node_id].box[1] = best.xmax
         nodes[0][node_id].box[2] = best.ymin
@@ -997,20 +1020,25 @@ def build_tree(objects, target, weight, params, uint64 seed):
     Parameters
     ----------
     objects : object
-        The training data indexed for the builder (``boxtrees._base._TrainingObjects``):
-        ``bounds``, shape (n_types, 4), the region ``(xmin, xmax, ymin, ymax)`` in which tests
-        of each type are drawn (``ymin = -inf`` marks one-dimensional objects), and either
+        The training data indexed for the builder (``boxtrees._base._TrainingObjects``).
+        A test's box spans the x and y columns of one of ``n_groups`` column groups (a group
+        of one column has no y: its y extent is unbounded). ``bounds``, shape (n_groups *
+        n_types, 4): at ``group * n_types + type``, the region ``(xmin, xmax, ymin, ymax)``
+        in which the tests of that group and type are drawn (``ymin = -inf`` marks a group
+        of one column); ``half_widths``, shape (n_groups * n_types, 2), the half-widths
+        along x and y of fixed and bounded boxes; and either
 
         - ``columns``, a float32 feature matrix of shape (n_samples, n_types), whose column
-          ``j`` is the one object of type ``j`` of each sample, and ``local_x``: draw the x
-          extent of a test within its column's range in the node; or
+          ``j`` is the one object of type ``j`` of each sample (``n_groups = 1``), and
+          ``local_x``: draw the x extent of a test within its column's range in the node; or
         - ``columns = None`` (or absent) and object sets: ``x, y, sample_of``, arrays of
-          shape (n_objects,), the objects grouped by segment (type position, then y band),
-          sorted by x within each segment, and the sample each belongs to;
-          ``segment_ptr``, shape (n_types * n_bands + 1,): segment ``g = type * n_bands +
-          band`` is ``segment_ptr[g]:segment_ptr[g + 1]``; ``band_edges``, shape
-          (n_bands + 1,): band ``b`` holds the objects with ``band_edges[b] <= y <
-          band_edges[b + 1]``, from -inf to +inf.
+          shape (n_groups * n_objects,), every group's copy of the objects (its x and y
+          columns) grouped by segment (group, type position, then y band), sorted by x
+          within each segment, and the sample each belongs to; ``segment_ptr``, shape
+          (n_groups * n_types * n_bands + 1,): segment ``g = (group * n_types + type) *
+          n_bands + band`` is ``segment_ptr[g]:segment_ptr[g + 1]``; ``band_edges``, shape
+          (n_groups, n_bands + 1): band ``b`` of a group holds its objects with
+          ``band_edges[group, b] <= y < band_edges[group, b + 1]``, from -inf to +inf.
     target : array of shape (n_samples,) or (n_samples, n_outputs)
         Targets (encoded class indicators for a classifier); ``n_samples < 2**31``.
     weight : array of shape (n_samples,)
@@ -1032,8 +1060,9 @@ def build_tree(objects, target, weight, params, uint64 seed):
     n_samples = len(target)
     if len(weight) != n_samples or not 0 < n_samples < INT_MAX:
         raise ValueError(f"target and weight must have the same length, from 1 to {INT_MAX - 1}")
-    if bounds.shape[1] != 4:
-        raise ValueError("bounds must be (n_types, 4)")
+    if (bounds.shape[1] != 4 or not 0 < objects.n_groups <= bounds.shape[0]
+            or bounds.shape[0] % objects.n_groups):
+        raise ValueError("bounds must be (n_groups * n_types, 4)")
     if not 0 < params.n_tests <= UINT_MAX or params.max_retries < 0:
         raise ValueError(f"n_tests must be in [1, {UINT_MAX}] and max_retries >= 0")
     weight = np.array(weight, dtype=np.float64)
@@ -1046,15 +1075,21 @@ def build_tree(objects, target, weight, params, uint64 seed):
     cdef _Splitter splitter
     if getattr(objects, "columns", None) is not None:
         segment_ptr = np.zeros(1, dtype=np.intp)        # no segments
+        if objects.n_groups != 1:
+            raise ValueError("a feature matrix has one column group")
         objects = SimpleNamespace(columns=objects.columns, bounds=objects.bounds,
+                                  half_widths=objects.half_widths, n_groups=1,
                                   local_x=objects.local_x, rows=kept)
         splitter = _ColumnSplitter(objects, segment_ptr, target, weight, params, seed)
     else:
         segment_ptr = np.array(objects.segment_ptr, dtype=np.intp)
-        n_objects, n_bands = len(objects.x), len(objects.band_edges) - 1
+        edges_shape = np.shape(objects.band_edges)
+        n_objects = len(objects.x)
+        n_bands = edges_shape[1] - 1 if len(edges_shape) == 2 else 0
         if n_bands < 1 or segment_ptr.shape != (bounds.shape[0] * n_bands + 1,):
-            raise ValueError("bounds must be (n_types, 4) and segment_ptr must have "
-                             "n_types * n_bands + 1 entries")
+            raise ValueError("band_edges must be (n_groups, n_bands + 1), bounds (n_groups * "
+                             "n_types, 4) and segment_ptr must have n_groups * n_types * "
+                             "n_bands + 1 entries")
         if scan_offsets(segment_ptr, n_objects) != -1:
             raise ValueError(f"segment_ptr must rise from 0 to the number of objects, {n_objects}")
         if kept is not None:
@@ -1089,4 +1124,5 @@ def _objects_of(objects, segment_ptr, kept, n_samples):
     ptr = np.concatenate([[0], np.cumsum(np.bincount(segment[keep], minlength=len(segment_ptr) - 1))])
     return SimpleNamespace(x=np.asarray(objects.x)[keep], y=np.asarray(objects.y)[keep],
                            sample_of=new_id[sample_of[keep]], band_edges=objects.band_edges,
-                           bounds=objects.bounds), ptr.astype(np.intp)
+                           bounds=objects.bounds, half_widths=objects.half_widths,
+                           n_groups=objects.n_groups), ptr.astype(np.intp)

@@ -51,6 +51,8 @@ class _SingleTree(BaseBoxTrees):
         max_retries=10,
         max_depth=None,
         view_bounds=None,
+        column_groups=None,
+        relative_width=False,
         refine_tests=False,
         random_state=None,
     ):
@@ -61,6 +63,8 @@ class _SingleTree(BaseBoxTrees):
         self.max_retries = max_retries
         self.max_depth = max_depth
         self.view_bounds = view_bounds
+        self.column_groups = column_groups
+        self.relative_width = relative_width
         self.refine_tests = refine_tests
         self.random_state = random_state
 

@@ -14,8 +14,9 @@ from ._extra_tree import BoxExtraTreeClassifier, BoxExtraTreeRegressor
 __all__ = ["BoxExtraTreesClassifier", "BoxExtraTreesRegressor"]
 
 # fitted attributes a forest hands to each of its trees
-_SHARED_FITTED = ("types_", "n_types_", "bounds_", "_fitted_on_features", "n_features_in_",
-                  "feature_names_in_", "n_outputs_", "classes_", "n_classes_")
+_SHARED_FITTED = ("types_", "n_types_", "n_attributes_", "column_groups_", "bounds_",
+                  "_fitted_on_features", "n_features_in_", "feature_names_in_", "n_outputs_",
+                  "classes_", "n_classes_")
 
 
 class _Forest(BaseBoxTrees):
@@ -41,6 +42,8 @@ class _Forest(BaseBoxTrees):
         max_retries=10,
         max_depth=None,
         view_bounds=None,
+        column_groups=None,
+        relative_width=False,
         refine_tests=False,
         bootstrap=False,
         n_jobs=None,
@@ -55,6 +58,8 @@ class _Forest(BaseBoxTrees):
         self.max_retries = max_retries
         self.max_depth = max_depth
         self.view_bounds = view_bounds
+        self.column_groups = column_groups
+        self.relative_width = relative_width
         self.refine_tests = refine_tests
         self.bootstrap = bootstrap
         self.n_jobs = n_jobs

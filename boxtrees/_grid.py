@@ -18,7 +18,9 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
     ``n_bins x n_bins`` equal cells and each sample becomes the ``n_bins * n_bins * n_types_``
     vector of per-cell, per-type counts, ordered as a C array of shape
     ``(n_bins, n_bins, n_types_)`` indexed ``[x cell, y cell, type]``, the types in the order
-    of ``types_``. Objects outside the grid and types not in ``types_`` are ignored.
+    of ``types_``. Objects outside the grid and types not in ``types_`` are ignored. The grid
+    lies over two of the objects' attributes, ``columns`` (one for objects of one attribute:
+    ``n_bins`` cells along it).
 
     A 2D feature matrix is read with column ``j`` as a one-dimensional object of type ``j``:
     each column's range is cut into ``n_bins`` cells and the output is the
@@ -29,12 +31,17 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
     n_bins : int, default=10
         Number of cells along each axis.
     view_bounds : array-like of 4 floats or float, default=None
-        Grid extent ``(xmin, xmax, ymin, ymax)``, or a half-width ``r`` for ``[-r, r]^2``.
+        Grid extent ``(xmin, xmax, ymin, ymax)`` over ``columns`` (``(low, high)`` for a grid
+        over one column, as for a feature matrix), or a half-width ``r`` for ``[-r, r]^2``.
         None: the bounding box of the objects seen at fit (per column for a feature matrix).
     n_types : int, default=None
         Count the type ids ``0 .. n_types - 1`` (a fixed layout, whatever the data). None:
         count the type ids seen at fit, so the output size follows the types present, not
         the largest id.
+    columns : tuple of 2 int, default=None
+        The attributes along which the grid's x and y cells lie (objects ``[f_1, ..., f_d,
+        type]``: indices into ``f``). None: ``(0, 1)``, the position of ``[x, y, type]``
+        objects, or ``(0,)`` for objects of one attribute.
 
     Attributes
     ----------
@@ -42,8 +49,12 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         Sorted type ids counted (the column indices for a feature matrix).
     n_types_ : int
         ``len(types_)``.
+    n_attributes_ : int
+        Number of attributes of the objects seen at fit (1 for a feature matrix).
+    columns_ : tuple of int
+        The attributes the grid lies over.
     bounds_ : ndarray of shape (n_types_, 4)
-        Grid extent used for each type.
+        Grid extent used for each type, ``(xmin, xmax, ymin, ymax)`` over ``columns_``.
     n_features_in_ : int
         Number of columns, when fitted on a feature matrix.
 
@@ -61,12 +72,14 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         "n_bins": [Interval(Integral, 1, None, closed="left")],
         "view_bounds": ["array-like", Interval(Real, 0, None, closed="neither"), None],
         "n_types": [Interval(Integral, 1, _MAX_TYPE, closed="both"), None],
+        "columns": [tuple, list, None],
     }
 
-    def __init__(self, n_bins=10, *, view_bounds=None, n_types=None):
+    def __init__(self, n_bins=10, *, view_bounds=None, n_types=None, columns=None):
         self.n_bins = n_bins
         self.view_bounds = view_bounds
         self.n_types = n_types
+        self.columns = columns
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None):
@@ -74,7 +87,7 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
 
         Parameters
         ----------
-        X : sequence of array-like of shape (n_i, 3), ObjectSets, or array of shape (n_samples, n_features)
+        X : sequence of array-like of shape (n_i, d + 1), ObjectSets, or array of shape (n_samples, n_features)
             Object sets, or a feature matrix.
         y : None
             Ignored.
@@ -84,7 +97,8 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         self : GridCounts
         """
         sets, _ = self._validate_input(X, reset=True)
-        data = sets.data
+        data, d = sets.data, self.n_attributes_
+        self.columns_ = _grid_columns(self.columns, d)
         if self._fitted_on_features:
             self.types_ = np.arange(self.n_features_in_)
             self.n_types_ = self.n_features_in_
@@ -94,27 +108,28 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
                     [x.min(0), x.max(0), np.zeros((self.n_types_, 2))]
                 ).astype(np.float64)
             else:
-                self.bounds_ = np.tile(check_view_bounds(self.view_bounds), (self.n_types_, 1))
+                bounds = np.pad(check_view_bounds(self.view_bounds, 1), (0, 2))
+                self.bounds_ = np.tile(bounds, (self.n_types_, 1))
             return self
         if self.n_types is not None:
             self.types_ = np.arange(self.n_types)
         else:
-            self.types_ = np.unique(data[:, 2].astype(np.intp)) if len(data) else np.zeros(1, np.intp)
+            self.types_ = np.unique(data[:, d].astype(np.intp)) if len(data) else np.zeros(1, np.intp)
         self.n_types_ = len(self.types_)
+        columns = list(self.columns_)
         if self.view_bounds is not None:
-            bounds = check_view_bounds(self.view_bounds)
+            bounds = check_view_bounds(self.view_bounds, len(columns))
         elif len(data):
-            bounds = np.array(
-                [data[:, 0].min(), data[:, 0].max(), data[:, 1].min(), data[:, 1].max()], dtype=np.float64
-            )
+            bounds = np.column_stack([data[:, columns].min(0), data[:, columns].max(0)]).ravel()
+            bounds = bounds.astype(np.float64)
         else:
             raise ValueError("GridCounts needs view_bounds when X holds no object at all")
-        self.bounds_ = np.tile(bounds, (self.n_types_, 1))
+        self.bounds_ = np.tile(np.pad(bounds, (0, 4 - len(bounds))), (self.n_types_, 1))
         return self
 
     def _grid_shape(self):
-        """Cells along x and y (one along y for feature-matrix columns)."""
-        return self.n_bins, (1 if self._fitted_on_features else self.n_bins)
+        """Cells along x and y (one along y for a grid over one column)."""
+        return self.n_bins, (self.n_bins if len(self.columns_) == 2 else 1)
 
     def transform(self, X):
         """Count objects per cell and type.
@@ -132,13 +147,13 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         sets, _ = self._validate_input(X, reset=False)
         nx, ny = self._grid_shape()
         n_out = nx * ny * self.n_types_
-        data = sets.data
-        types = np.searchsorted(self.types_, data[:, 2].astype(np.intp))
-        keep = self.types_[np.minimum(types, self.n_types_ - 1)] == data[:, 2]
+        data, d, columns = sets.data, self.n_attributes_, self.columns_
+        types = np.searchsorted(self.types_, data[:, d].astype(np.intp))
+        keep = self.types_[np.minimum(types, self.n_types_ - 1)] == data[:, d]
         types, data, sample = types[keep], data[keep], sets.sample_index()[keep]
         b = self.bounds_[types]
-        ix = _cell(data[:, 0], b[:, 0], b[:, 1], nx)
-        iy = _cell(data[:, 1], b[:, 2], b[:, 3], ny) if ny > 1 else np.zeros_like(ix)
+        ix = _cell(data[:, columns[0]], b[:, 0], b[:, 1], nx)
+        iy = _cell(data[:, columns[1]], b[:, 2], b[:, 3], ny) if ny > 1 else np.zeros_like(ix)
         inside = (ix >= 0) & (iy >= 0)
         index = sample * n_out + (ix * ny + iy) * self.n_types_ + types
         counts = np.bincount(index[inside], minlength=len(sets) * n_out)
@@ -160,6 +175,20 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         else:
             names = [f"type{t}_x{i}_y{j}" for i in range(nx) for j in range(ny) for t in self.types_]
         return np.asarray(names, dtype=object)
+
+
+def _grid_columns(columns, n_attributes):
+    """The attributes a grid lies over: ``columns`` validated, or (0, 1), or (0,) for objects
+    of one attribute."""
+    if columns is None:
+        return (0, 1) if n_attributes >= 2 else (0,)
+    columns = tuple(columns)
+    if (not 1 <= len(columns) <= 2 or len(set(columns)) != len(columns)
+            or not all(isinstance(c, Integral) and 0 <= c < n_attributes for c in columns)):
+        raise ValueError(f"columns must be one or two distinct attribute indices in "
+                         f"[0, {n_attributes}) (the objects have {n_attributes} attributes "
+                         f"before their type); got {columns!r}")
+    return tuple(int(c) for c in columns)
 
 
 def _cell(v, low, high, n_bins):

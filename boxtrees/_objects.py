@@ -1,8 +1,9 @@
-"""Ragged batches of 2D object sets, and the input checks shared by the estimators.
+"""Ragged batches of object sets, and the input checks shared by the estimators.
 
-An object is a row ``[x, y, type]``: a position and a non-negative integer type id. A sample is a
-set of objects (possibly empty). A batch of samples is stored as one ``(n_objects, 3)`` float32
-array plus offsets, so it is cheap to build, slice and hand to the Cython core.
+An object is a row ``[f_1, ..., f_d, type]``: ``d >= 1`` real attributes (a position, a size, a
+velocity...) and a non-negative integer type id, last. A sample is a set of objects (possibly
+empty). A batch of samples is stored as one ``(n_objects, d + 1)`` float32 array plus offsets,
+so it is cheap to build, slice and hand to the Cython core.
 """
 import warnings
 from numbers import Integral
@@ -16,6 +17,7 @@ __all__ = ["ObjectSets"]
 
 _MAX_TYPE = 2**24  # float32 holds every integer type id below this exactly
 _FLOAT32_MAX = float(np.finfo(np.float32).max)
+_DEFAULT_WIDTH = 3  # the columns of a batch with no object at all: [x, y, type]
 
 
 def _offsets_from_sizes(sizes):
@@ -27,7 +29,7 @@ def _offsets_from_sizes(sizes):
 
 _ROW_PROBLEMS = {
     RowProblem.NOT_FINITE: "contain NaN or infinite values",
-    RowProblem.TOO_LARGE: "have coordinates too large for float32 (|value| > 3.4e38)",
+    RowProblem.TOO_LARGE: "have attributes too large for float32 (|value| > 3.4e38)",
     RowProblem.NEGATIVE_TYPE: "have negative type ids; type ids must be integers >= 0",
     RowProblem.NON_INTEGER_TYPE: "have non-integer type ids; type ids must be integers >= 0",
     RowProblem.TYPE_TOO_LARGE: f"have type ids >= {_MAX_TYPE}, which are not supported",
@@ -54,17 +56,23 @@ def _check_offsets(offsets, n_rows):
     return offsets
 
 
+def _empty_width(array):
+    """The columns of an empty set: its own when it is 2D with at least 2, else [x, y, type]."""
+    shape = np.shape(array)
+    return shape[1] if len(shape) == 2 and shape[1] >= 2 else _DEFAULT_WIDTH
+
+
 def _check_rows(data, what="object sets"):
-    """Validate object rows and return them as a C-contiguous float32 ``(n, 3)`` array."""
+    """Validate object rows and return them as a C-contiguous float32 ``(n, d + 1)`` array."""
     data = np.asarray(data)
     if data.dtype.kind not in "biuf":
         raise TypeError(f"{what} must hold real numbers, got an array of dtype {data.dtype}")
     if data.size == 0:
-        return np.empty((0, 3), dtype=np.float32)
-    if data.ndim != 2 or data.shape[1] != 3:
+        return np.empty((0, _empty_width(data)), dtype=np.float32)
+    if data.ndim != 2 or data.shape[1] < 2:
         raise ValueError(
-            f"{what} must be arrays of shape (n_objects, 3) with columns [x, y, type]; "
-            f"got shape {data.shape}"
+            f"{what} must be arrays of shape (n_objects, d + 1) with columns [f_1, ..., f_d, "
+            f"type], d >= 1; got shape {data.shape}"
         )
     if data.dtype != np.float32:
         data = data.astype(np.float64, copy=False)
@@ -78,7 +86,9 @@ def _check_rows(data, what="object sets"):
 class ObjectSets:
     """A batch of object sets stored as one array of rows plus offsets.
 
-    Set ``i`` is ``data[offsets[i]:offsets[i + 1]]``. Building one (with the constructor,
+    Each object is a row ``[f_1, ..., f_d, type]``: ``d >= 1`` attributes and its type id,
+    last (``[x, y, type]`` for positions in the plane). Set ``i`` is
+    ``data[offsets[i]:offsets[i + 1]]``. Building one (with the constructor,
     `from_sequence`, `from_features` or `concatenate`) validates its content; slicing and
     indexing return views or compact copies without re-validation. The arrays are
     not frozen (``sets[i]`` is a writable view): the estimators check a batch again each time
@@ -87,9 +97,9 @@ class ObjectSets:
 
     Parameters
     ----------
-    data : array-like of shape (n_objects, 3)
-        Rows ``[x, y, type]`` of all sets, set after set. Coordinates must be finite; types
-        non-negative integers.
+    data : array-like of shape (n_objects, d + 1)
+        Rows ``[f_1, ..., f_d, type]`` of all sets, set after set. Attributes must be finite;
+        types non-negative integers.
     offsets : array-like of int of shape (n_sets + 1,)
         Non-decreasing, starting at 0 and ending at ``n_objects``.
 
@@ -98,8 +108,8 @@ class ObjectSets:
     >>> import numpy as np
     >>> from boxtrees import ObjectSets
     >>> sets = ObjectSets.from_sequence([np.array([[0.5, 1.0, 0]]), np.empty((0, 3))])
-    >>> len(sets), sets.sizes.tolist()
-    (2, [1, 0])
+    >>> len(sets), sets.sizes.tolist(), sets.n_attributes
+    (2, [1, 0], 2)
     """
 
     __slots__ = ("data", "offsets")
@@ -117,11 +127,13 @@ class ObjectSets:
 
     @classmethod
     def from_sequence(cls, sets):
-        """Build from a sequence of ``(n_i, 3)`` arrays (empty sets allowed).
+        """Build from a sequence of ``(n_i, d + 1)`` arrays (empty sets allowed).
 
         Parameters
         ----------
-        sets : sequence of array-like of shape (n_i, 3)
+        sets : sequence of array-like of shape (n_i, d + 1)
+            Rows ``[f_1, ..., f_d, type]``; every non-empty set has the same ``d``. An empty
+            set may have any shape of size 0.
 
         Returns
         -------
@@ -129,32 +141,46 @@ class ObjectSets:
         """
         if len(sets) == 1:  # fast path: one set, as when predicting for a single observation
             data = np.asarray(sets[0])
-            if data.size == 0 or (data.ndim == 2 and data.shape[1] == 3):
+            if data.size == 0 or (data.ndim == 2 and data.shape[1] >= 2):
                 data = _check_rows(data)
                 return cls._trusted(data, np.array([0, len(data)], dtype=np.intp))
-        arrays = []
+        arrays, width, first = [], None, None
         for i, s in enumerate(sets):
             if s is None:
-                raise ValueError(f"each object set must be an array of shape (n_objects, 3); set {i} is None")
+                raise ValueError(f"each object set must be an array of shape (n_objects, d + 1); "
+                                 f"set {i} is None")
             a = np.asarray(s)
             if a.size == 0:
-                a = np.empty((0, 3), dtype=np.float32)
-            elif a.ndim != 2 or a.shape[1] != 3:
+                arrays.append(a)
+                continue
+            if a.ndim != 2 or a.shape[1] < 2:
                 raise ValueError(
-                    f"each object set must have shape (n_objects, 3) with columns "
-                    f"[x, y, type]; set {i} has shape {a.shape}"
+                    f"each object set must have shape (n_objects, d + 1) with columns "
+                    f"[f_1, ..., f_d, type], d >= 1; set {i} has shape {a.shape}"
+                )
+            if width is None:
+                width, first = a.shape[1], (i, a.shape)
+            elif a.shape[1] != width:
+                raise ValueError(
+                    f"every object set must have the same columns [f_1, ..., f_d, type]; set "
+                    f"{first[0]} has shape {first[1]} but set {i} has shape {a.shape}"
                 )
             arrays.append(a)
-        sizes = np.fromiter((len(a) for a in arrays), dtype=np.intp, count=len(arrays))
-        data = np.concatenate(arrays) if arrays else np.empty((0, 3))
+        if width is None:   # no object at all: the empty sets' width, if they agree
+            widths = {_empty_width(a) for a in arrays}
+            width = widths.pop() if len(widths) == 1 else _DEFAULT_WIDTH
+        sizes = np.fromiter((len(a) if a.size else 0 for a in arrays), dtype=np.intp,
+                            count=len(arrays))
+        data = np.concatenate([a for a in arrays if a.size]) if sizes.any() else \
+            np.empty((0, width))
         return cls._trusted(_check_rows(data), _offsets_from_sizes(sizes))
 
     @classmethod
     def from_features(cls, X):
         """Read a 2D feature matrix as object sets: column ``j`` is one object of type ``j``.
 
-        The value is the object's x coordinate (as float32); y is 0. Every sample is a set of
-        ``n_features`` objects, one of each type.
+        The value is the object's one attribute (as float32): rows ``[value, type]``, d = 1.
+        Every sample is a set of ``n_features`` objects, one of each type.
 
         Parameters
         ----------
@@ -196,10 +222,51 @@ class ObjectSets:
         n_samples, n_features = X.shape
         if n_features > _MAX_TYPE:
             raise ValueError(f"X has {n_features} features; at most {_MAX_TYPE} are supported")
-        data = np.zeros((n_samples * n_features, 3), dtype=np.float32)
+        data = np.empty((n_samples * n_features, 2), dtype=np.float32)
         data[:, 0] = X.ravel()
-        data[:, 2] = np.tile(np.arange(n_features, dtype=np.float32), n_samples)
+        data[:, 1] = np.tile(np.arange(n_features, dtype=np.float32), n_samples)
         return cls._trusted(data, _offsets_from_sizes(np.full(n_samples, n_features)))
+
+    @classmethod
+    def from_padded(cls, array, mask):
+        """Build from padded rows: sample ``i`` is the rows ``array[i, j]`` where
+        ``mask[i, j]`` is true, in order.
+
+        This is the layout of fixed-size observations, such as ``envs.PaddedObjects`` (its
+        last column is the mask) or highway-env's kinematics (its ``presence`` column).
+
+        Parameters
+        ----------
+        array : array-like of shape (n_sets, max_objects, d + 1)
+            Rows ``[f_1, ..., f_d, type]``; masked-out rows may hold anything.
+        mask : array-like of bool of shape (n_sets, max_objects)
+            Which rows are objects.
+
+        Returns
+        -------
+        ObjectSets
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from boxtrees import ObjectSets
+        >>> padded = np.array([[[1.0, 2.0, 0], [0, 0, 0]], [[0, 0, 0], [0, 0, 0]]])
+        >>> ObjectSets.from_padded(padded, padded[:, :, 0] != 0).sizes.tolist()
+        [1, 0]
+        """
+        array, mask = np.asarray(array), np.asarray(mask)
+        if array.ndim != 3:
+            raise ValueError(f"padded rows must be an array of shape (n_sets, max_objects, "
+                             f"d + 1); got shape {array.shape}")
+        if mask.shape != array.shape[:2]:
+            raise ValueError(f"mask must have shape {array.shape[:2]} (n_sets, max_objects), "
+                             f"one flag per row; got {mask.shape}")
+        if mask.dtype != bool:
+            if mask.dtype.kind not in "biu" or not np.isin(mask, (0, 1)).all():
+                raise TypeError(f"mask must hold booleans (or 0/1), got dtype {mask.dtype}")
+            mask = mask.astype(bool)
+        data = _check_rows(array[mask].reshape(-1, array.shape[2]))
+        return cls._trusted(data, _offsets_from_sizes(mask.sum(axis=1)))
 
     @classmethod
     def concatenate(cls, batches):
@@ -235,8 +302,9 @@ class ObjectSets:
             raise TypeError(f"ObjectSets.concatenate takes an iterable of ObjectSets, got "
                             f"{type(batches).__name__}") from None
         if not batches:
-            return cls._trusted(np.empty((0, 3), dtype=np.float32), np.zeros(1, dtype=np.intp))
-        data, sizes = [], []
+            return cls._trusted(np.empty((0, _DEFAULT_WIDTH), dtype=np.float32),
+                                np.zeros(1, dtype=np.intp))
+        data, sizes, width = [], [], None
         for i, batch in enumerate(batches):
             if not isinstance(batch, ObjectSets):
                 raise TypeError(
@@ -249,8 +317,18 @@ class ObjectSets:
                 offsets = _check_offsets(batch.offsets, len(rows))
             except ValueError as error:
                 raise ValueError(f"batch {i} of ObjectSets.concatenate: {error}") from None
+            if len(rows):
+                if width is not None and rows.shape[1] != width[1]:
+                    raise ValueError(f"every batch of ObjectSets.concatenate must have the same "
+                                     f"columns; batch {width[0]} has {width[1]} but batch {i} "
+                                     f"has {rows.shape[1]}")
+                width = width or (i, rows.shape[1])
             data.append(rows)
             sizes.append(np.diff(offsets))
+        if width is not None:   # batches with no object may have other widths
+            data = [rows if len(rows) else rows.reshape(0, width[1]) for rows in data]
+        else:
+            data = [np.empty((0, data[0].shape[1]), dtype=np.float32)]
         return cls._trusted(np.concatenate(data), _offsets_from_sizes(np.concatenate(sizes)))
 
     def __len__(self):
@@ -266,12 +344,17 @@ class ObjectSets:
         """Total number of objects."""
         return len(self.data)
 
+    @property
+    def n_attributes(self):
+        """Number of attributes of each object (``d``: its columns but the type)."""
+        return self.data.shape[1] - 1
+
     def sample_index(self):
         """The set each object row belongs to, shape (n_objects,)."""
         return np.repeat(np.arange(len(self), dtype=np.intp), self.sizes)
 
     def __getitem__(self, index):
-        """``sets[i]`` is the ``(n_i, 3)`` array of set ``i`` (a view); slices, integer arrays
+        """``sets[i]`` is the ``(n_i, d + 1)`` array of set ``i`` (a view); slices, integer arrays
         and boolean masks give a new ``ObjectSets``."""
         if isinstance(index, Integral):
             n = len(self)
@@ -306,7 +389,8 @@ class ObjectSets:
             yield self.data[self.offsets[i] : self.offsets[i + 1]]
 
     def __repr__(self):
-        return f"ObjectSets(n_sets={len(self)}, n_objects={self.n_objects})"
+        return (f"ObjectSets(n_sets={len(self)}, n_objects={self.n_objects}, "
+                f"n_attributes={self.n_attributes})")
 
     def __getstate__(self):
         return {"data": self.data, "offsets": self.offsets}
@@ -346,8 +430,8 @@ def is_feature_matrix(X):
     """Whether ``X`` is read as a 2D feature matrix rather than as object sets.
 
     Object sets are an :class:`ObjectSets` (or any object with ``data`` and ``offsets``
-    arrays, such as the batched observations of ``envs``), a 3D array
-    ``(n_samples, n_objects, 3)``, or a sequence (list, tuple, 1D object array, pandas Series)
+    arrays, such as the batched observations of ``envs``), a 3D array (rejected there: padded
+    rows need their mask, `ObjectSets.from_padded`), or a sequence (list, tuple, 1D object array, pandas Series)
     of which any item is a 2D array or empty: the sets path then names the position of every
     item that is not a set. Anything else (2D arrays, data frames, sparse matrices, lists of
     rows, and invalid inputs) goes the feature-matrix way, where scikit-learn's own validation
@@ -371,12 +455,11 @@ def as_object_sets(X):
     if isinstance(X, ObjectSets) or _is_ragged_batch(X):
         return ObjectSets(X.data, X.offsets)
     if isinstance(X, np.ndarray) and X.ndim == 3:
-        if X.shape[2] != 3:
-            raise ValueError(
-                f"a 3D array of object sets must have shape (n_samples, n_objects, 3); got {X.shape}"
-            )
-        data = _check_rows(X.reshape(-1, 3))
-        return ObjectSets._trusted(data, _offsets_from_sizes(np.full(X.shape[0], X.shape[1])))
+        raise ValueError(
+            f"X is a 3D array of shape {X.shape}: its rows may be padding, which would be read "
+            f"as objects. Pass ObjectSets.from_padded(X, mask) with the mask of the rows that "
+            f"are objects, or a list of (n_i, d + 1) arrays"
+        )
     return ObjectSets.from_sequence(list(X) if hasattr(X, "iloc") else X)
 
 
@@ -396,23 +479,27 @@ def _check_targets(y):
     return y
 
 
-def check_view_bounds(view_bounds):
-    """Validate ``view_bounds`` (``(xmin, xmax, ymin, ymax)`` or a half-width ``r`` for
-    ``[-r, r]^2``) and return it as a float array of 4."""
+def check_view_bounds(view_bounds, n_attributes=2):
+    """Validate ``view_bounds`` (``(low_1, high_1, ..., low_d, high_d)``, for ``d = 2``
+    ``(xmin, xmax, ymin, ymax)``, or a half-width ``r`` for ``[-r, r]^d``) and return it as a
+    float array of ``2 * n_attributes``."""
     bounds = np.asarray(view_bounds, dtype=np.float64)
     if bounds.ndim == 0:
-        bounds = np.array([-bounds, bounds, -bounds, bounds])
-    if bounds.shape != (4,) or not np.isfinite(bounds).all():
+        bounds = np.tile([-bounds, bounds], n_attributes)
+    if bounds.shape != (2 * n_attributes,) or not np.isfinite(bounds).all():
+        what = "(xmin, xmax, ymin, ymax)" if n_attributes == 2 else \
+            f"(low, high) of each of the {n_attributes} attributes"
         raise ValueError(
-            f"view_bounds must be (xmin, xmax, ymin, ymax) of finite numbers or a positive "
-            f"half-width; got {view_bounds!r}"
+            f"view_bounds must be {what} of finite numbers or a positive half-width; got "
+            f"{view_bounds!r}"
         )
     if np.abs(bounds).max() > _FLOAT32_MAX:
         raise ValueError(f"view_bounds must fit in float32 (|value| <= 3.4e38); got {view_bounds!r}")
-    if bounds[0] >= bounds[1] or bounds[2] >= bounds[3]:
-        raise ValueError(f"view_bounds needs xmin < xmax and ymin < ymax; got {view_bounds!r}")
+    if (bounds[0::2] >= bounds[1::2]).any():
+        raise ValueError(f"view_bounds needs each low below its high (xmin < xmax, ymin < ymax); "
+                         f"got {view_bounds!r}")
     single = bounds.astype(np.float32)
-    if single[0] >= single[1] or single[2] >= single[3]:
+    if (single[0::2] >= single[1::2]).any():
         raise ValueError(f"view_bounds collapses to an empty region in float32; got {view_bounds!r}")
     return bounds
 
@@ -437,7 +524,7 @@ class ObjectInputMixin:
             if dense and not fitted_dense:
                 raise ValueError(
                     f"{type(self).__name__} was fitted on object sets, but X is read as a 2D "
-                    f"feature matrix; pass a sequence of (n_i, 3) arrays or an ObjectSets "
+                    f"feature matrix; pass a sequence of (n_i, d + 1) arrays or an ObjectSets "
                     f"(a single object set must be wrapped in a list)"
                 )
             if not dense and fitted_dense:
@@ -452,13 +539,24 @@ class ObjectInputMixin:
             else:
                 X = validate_data(self, X, reset=reset, dtype=np.float32)
             sets = X if matrix else ObjectSets._from_validated_features(X)
+            n_attributes = 1
         else:
             sets = as_object_sets(X)
+            n_attributes = sets.n_attributes
             if reset:
                 for attr in ("n_features_in_", "feature_names_in_"):
                     self.__dict__.pop(attr, None)
                 if len(sets) == 0:
                     raise ValueError("X has no samples; at least one sample is required")
+            elif n_attributes != self.n_attributes_:
+                if sets.n_objects:
+                    raise ValueError(
+                        f"X has objects of {n_attributes + 1} columns, but "
+                        f"{type(self).__name__} was fitted on objects of "
+                        f"{self.n_attributes_ + 1} columns ([f_1, ..., f_d, type], d = "
+                        f"{self.n_attributes_})")
+                n_attributes = self.n_attributes_   # no object: nothing to read
+                sets = ObjectSets._trusted(sets.data.reshape(0, n_attributes + 1), sets.offsets)
             if requires_y:
                 if y is None:
                     raise ValueError(f"{type(self).__name__} requires y to be passed, but the target y is None")
@@ -466,6 +564,7 @@ class ObjectInputMixin:
                                 input_name="y")
         if reset:
             self._fitted_on_features = dense
+            self.n_attributes_ = n_attributes
         if requires_y:
             y = _check_targets(y)
             if len(y) != len(sets):

@@ -1,12 +1,13 @@
 """Forest traversal: predictions and leaf indices for batches of object sets.
 
-A `PackedForest` holds the node tests of fitted trees as one array of 32-byte records (half a
-cache line; a left child follows its parent, so a root-to-leaf walk touches few cache lines).
+A `PackedForest` holds the node tests of fitted trees as one array of 40-byte records (a left
+child follows its parent, so a root-to-leaf walk touches few cache lines): the box of a test
+bounds at most two of the objects' attributes, the record names which.
 It copies and validates the trees it is built from and keeps its arrays private, so no value
 reachable from Python can send a walk outside them.
 
 The traversal entry points regroup each sample's objects by type first, so a node test scans
-only the sample's objects of the tested type; they re-validate, on every call and at the point
+only the sample's objects of the tested type, attribute by attribute; they re-validate, on every call and at the point
 of use, the rows and offsets they read (a batch may have changed since it was checked), and
 report the first bad row instead of reading past an array. Samples are processed in blocks,
 tree by tree, so that a tree's nodes stay in cache across a block. The walk itself is a kernel
@@ -28,9 +29,11 @@ cdef extern from "_simd.h":
         int32 right
         int32 object_type
         int32 threshold
+        int32 x_column
+        int32 y_column
         coord_t box[4]
     ctypedef struct boxtrees_kernels:
-        intp_t (*find_leaf)(const boxtrees_node* nodes, const coord_t* x, const coord_t* y,
+        intp_t (*find_leaf)(const boxtrees_node* nodes, const coord_t* features, intp_t stride,
                             const intp_t* types) noexcept nogil
     boxtrees_kernels boxtrees_select_kernels(int allow_simd) noexcept nogil
 
@@ -53,7 +56,7 @@ cdef coord_t _NO_OBJECT = 0
 
 _NODE_FIELDS = {  # BoxTree array -> (dtype kind, trailing shape)
     "children_left": ("i", ()), "children_right": ("i", ()), "object_type": ("i", ()),
-    "threshold": ("i", ()), "box": ("f", (4,)), "value": ("f", None),   # None: any width
+    "threshold": ("i", ()), "box": ("f", None), "value": ("f", None),   # None: any width
 }
 _INT32 = np.iinfo(np.int32)
 
@@ -87,6 +90,10 @@ def _tree_arrays(k, tree):
     if not 0 < n < _INT32.max:
         raise ValueError(f"tree {k}: value must be a 1D or 2D array of 1 to {_INT32.max - 1} nodes")
     arrays["value"] = arrays["value"].reshape(n, -1)
+    box = arrays["box"]
+    if box.ndim != 2 or box.shape[1] < 2 or box.shape[1] % 2:
+        raise ValueError(f"tree {k}: box must have shape (node_count, 2 * n_attributes); "
+                         f"got {box.shape}")
     for name, (kind, tail) in _NODE_FIELDS.items():
         shape = (n, *(tail if tail is not None else arrays[name].shape[1:]))
         if arrays[name].shape != shape:
@@ -101,7 +108,7 @@ cdef class PackedForest:
     Parameters
     ----------
     trees : sequence of BoxTree
-        The trees; their arrays are copied.
+        The trees, over objects of the same number of attributes; their arrays are copied.
     types : array-like of int
         The sorted, distinct type ids the trees may test; a node's type is stored as its
         position in ``types``.
@@ -111,7 +118,8 @@ cdef class PackedForest:
     ValueError
         When a tree's arrays could send a walk anywhere but down to one of its own leaves
         (child ids out of range or not after their parent's, a tested type not in ``types``,
-        a threshold beyond int32, a NaN box bound) or hold a non-finite value.
+        a threshold beyond int32, a NaN box bound, a box that bounds more than two
+        attributes) or hold a non-finite value.
     """
 
     cdef tuple _arrays          # the private arrays behind the pointers of _view
@@ -120,6 +128,7 @@ cdef class PackedForest:
     cdef readonly intp_t n_trees
     cdef readonly intp_t n_outputs
     cdef readonly intp_t n_types
+    cdef readonly intp_t n_attributes
     cdef bint _dense            # types are 0 .. n_types - 1: an id is its own position
 
     def __init__(self, trees, types):
@@ -132,6 +141,9 @@ cdef class PackedForest:
         n_outputs = per_tree[0]["value"].shape[1]
         if any(a["value"].shape[1] != n_outputs for a in per_tree):
             raise ValueError("the trees of a forest must have the same number of outputs")
+        n_attributes = per_tree[0]["box"].shape[1] // 2
+        if any(a["box"].shape[1] != 2 * n_attributes for a in per_tree):
+            raise ValueError("the trees of a forest must have boxes over the same attributes")
         counts = np.array([len(a["value"]) for a in per_tree], dtype=np.intp)
         offsets = np.zeros(len(counts) + 1, dtype=np.intp)
         np.cumsum(counts, out=offsets[1:])
@@ -145,6 +157,8 @@ cdef class PackedForest:
         position = np.searchsorted(types, cat["object_type"].astype(np.int64))
         known = types[np.minimum(position, len(types) - 1)] == cat["object_type"]
         threshold = cat["threshold"].astype(np.int64)
+        box = cat["box"].astype(np.float32).reshape(n_nodes, n_attributes, 2)
+        bounded = ~(np.isneginf(box[:, :, 0]) & np.isposinf(box[:, :, 1]))
         problems = [
             ((~inner & (right != TREE_LEAF)) | (inner & ((left <= node) | (left >= size)
                                                          | (right <= node) | (right >= size))),
@@ -154,6 +168,8 @@ cdef class PackedForest:
             (inner & ((threshold < _INT32.min) | (threshold > _INT32.max)),
              "has a threshold outside the int32 range"),
             (inner & np.isnan(cat["box"]).any(axis=1), "has a NaN box bound"),
+            (inner & (bounded.sum(axis=1) > 2),
+             "has a box that bounds more than two attributes"),
             (~np.isfinite(cat["value"]).all(axis=1), "has a non-finite value"),
         ]
         for bad, what in problems:
@@ -166,7 +182,18 @@ cdef class PackedForest:
         nodes["right"] = np.where(inner, right, TREE_LEAF)
         nodes["object_type"] = np.where(inner, position, 0)
         nodes["threshold"] = np.where(inner, threshold, 0)
-        nodes["box"] = cat["box"]
+        # a box over two attributes (or one, y unbounded; or none: everything is inside)
+        x_column = np.argmax(bounded, axis=1)
+        y_column = np.where(bounded.sum(axis=1) == 2,
+                            n_attributes - 1 - np.argmax(bounded[:, ::-1], axis=1), x_column)
+        rows = np.arange(n_nodes)
+        unbounded_y = (y_column == x_column)[:, None]
+        nodes["x_column"] = np.where(inner, x_column, 0)
+        nodes["y_column"] = np.where(inner, y_column, 0)
+        nodes["box"] = np.column_stack([
+            box[rows, x_column],
+            np.where(unbounded_y, [-np.inf, np.inf], box[rows, y_column]),
+        ])
         value = np.ascontiguousarray(cat["value"], dtype=np.float64)
         self._arrays = (nodes, value, offsets, types)
         self._view.nodes = <const boxtrees_node*>cnp.PyArray_DATA(nodes)
@@ -176,6 +203,7 @@ cdef class PackedForest:
         self._view.n_outputs = self.n_outputs = n_outputs
         self._types = <const intp_t*>cnp.PyArray_DATA(types)
         self.n_types = len(types)
+        self.n_attributes = n_attributes
         self._dense = types.max() == len(types) - 1
 
     cdef inline intp_t _position(self, intp_t t) noexcept nogil:
@@ -201,10 +229,11 @@ cdef class PackedForest:
         """
         cdef intp_t[::1] offs = np.array(offsets, dtype=np.intp)    # read once, here
         cdef intp_t n_sets = offs.shape[0] - 1, n_rows = data.shape[0], stride = self.n_types + 1
-        cdef intp_t i, k, d, pos = 0, row = -1
+        cdef intp_t i, k, d, c, pos = 0, row = -1, n_attributes = self.n_attributes
         cdef int problem = ROW_OK
-        if data.shape[1] != 3:
-            raise ValueError(f"object rows must have 3 columns [x, y, type], got {data.shape[1]}")
+        if data.shape[1] != n_attributes + 1:
+            raise ValueError(f"object rows must have {n_attributes + 1} columns (the forest's "
+                             f"{n_attributes} attributes and the type), got {data.shape[1]}")
         for i in range(n_sets + 1):
             if offs[i] < 0 or offs[i] > n_rows or (i > 0 and offs[i] < offs[i - 1]):
                 return BAD_OFFSETS, i
@@ -214,14 +243,14 @@ cdef class PackedForest:
         with nogil:
             for i in range(n_sets):
                 for k in range(offs[i], offs[i + 1]):
-                    problem = row_problem(data[k, 0], data[k, 1], data[k, 2], INFINITY, MAX_TYPE)
+                    problem = row_problem(&data[k, 0], n_attributes, INFINITY, MAX_TYPE)
                     if problem == ROW_TYPE_TOO_LARGE:
                         problem = ROW_OK       # an id no tree tests
                         continue
                     if problem != ROW_OK:
                         row = k
                         break
-                    d = self._position(<intp_t>data[k, 2])
+                    d = self._position(<intp_t>data[k, n_attributes])
                     if d >= 0:
                         type_ptr[i, d + 1] += 1
                 if problem != ROW_OK:
@@ -232,9 +261,8 @@ cdef class PackedForest:
                     type_ptr[i, d + 1] = pos
         if problem != ROW_OK:
             return problem, row
-        x_arr = np.zeros(pos, dtype=np.float32)
-        y_arr = np.zeros(pos, dtype=np.float32)
-        cdef coord_t[::1] x = x_arr, y = y_arr
+        features_arr = np.zeros((n_attributes, pos), dtype=np.float32)
+        cdef coord_t[:, ::1] features = features_arr
         with nogil:
             # the rows are read again: every index is re-checked where it is used, so rows
             # changed in between cannot move a write out of its sample's range
@@ -242,24 +270,25 @@ cdef class PackedForest:
                 for d in range(self.n_types):
                     cursor[d] = type_ptr[i, d]
                 for k in range(offs[i], offs[i + 1]):
-                    if not (0 <= data[k, 2] < MAX_TYPE):
+                    if not (0 <= data[k, n_attributes] < MAX_TYPE):
                         continue
-                    d = self._position(<intp_t>data[k, 2])
+                    d = self._position(<intp_t>data[k, n_attributes])
                     if d >= 0 and cursor[d] < type_ptr[i, d + 1]:
-                        x[cursor[d]] = data[k, 0]
-                        y[cursor[d]] = data[k, 1]
+                        for c in range(n_attributes):
+                            features[c, cursor[d]] = data[k, c]
                         cursor[d] += 1
-            _walk(&self._view, &x[0] if pos else &_NO_OBJECT, &y[0] if pos else &_NO_OBJECT,
+            _walk(&self._view, &features[0, 0] if pos else &_NO_OBJECT, pos,
                   &type_ptr[0, 0] if n_sets > 0 else NULL, stride, n_sets, mean, leaves)
         return ROW_OK, -1
 
 
-cdef void _walk(const ForestView* forest, const coord_t* x, const coord_t* y, const intp_t* type_ptr,
-                intp_t stride, intp_t n_samples, float64_t* mean, intp_t* leaves) noexcept nogil:
+cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_objects,
+                const intp_t* type_ptr, intp_t stride, intp_t n_samples, float64_t* mean,
+                intp_t* leaves) noexcept nogil:
     """Walk every sample through every tree, in blocks, tree by tree.
 
-    Sample ``i``'s objects of type position ``d`` are ``x[type_ptr[i * stride + d]:type_ptr[i
-    * stride + d + 1]]`` (and ``y``). Writes the mean leaf value per sample into ``mean`` or,
+    Attribute ``c`` of sample ``i``'s objects of type position ``d`` is ``features[c *
+    n_objects + type_ptr[i * stride + d]:c * n_objects + type_ptr[i * stride + d + 1]]``. Writes the mean leaf value per sample into ``mean`` or,
     when ``mean`` is NULL, the tree-local leaf ids into the (n_samples, n_trees) ``leaves``;
     ``mean`` holds ``n_outputs`` values per sample.
     """
@@ -275,7 +304,8 @@ cdef void _walk(const ForestView* forest, const coord_t* x, const coord_t* y, co
                 mean[i] = 0.0
         for tree in range(n_trees):
             for i in range(block, block_end):
-                leaf = _kernels.find_leaf(nodes + tree_offsets[tree], x, y, type_ptr + i * stride)
+                leaf = _kernels.find_leaf(nodes + tree_offsets[tree], features, n_objects,
+                                          type_ptr + i * stride)
                 if mean == NULL:
                     leaves[i * n_trees + tree] = leaf
                     continue
@@ -292,7 +322,7 @@ def predict_mean(PackedForest forest, const coord_t[:, ::1] data, const intp_t[:
                  float64_t[:, ::1] out):
     """Write the mean leaf values over the trees of each sample into ``out``.
 
-    Sample ``i`` is ``data[offsets[i]:offsets[i + 1]]`` (rows ``[x, y, type]``); ``out`` has
+    Sample ``i`` is ``data[offsets[i]:offsets[i + 1]]`` (rows ``[f_1, ..., f_d, type]``); ``out`` has
     shape (n_samples, n_outputs). Returns ``(problem, row)`` as ``PackedForest._run``.
     """
     if out.shape[0] != offsets.shape[0] - 1 or out.shape[1] != forest.n_outputs:

@@ -3,24 +3,22 @@ from enum import IntEnum
 
 from ._utils cimport (
     BAD_OFFSETS, ROW_NEGATIVE_TYPE, ROW_NON_INTEGER_TYPE, ROW_NOT_FINITE, ROW_OK, ROW_TOO_LARGE,
-    ROW_TYPE_TOO_LARGE, intp_t, row_problem,
+    ROW_TYPE_TOO_LARGE, intp_t, real_t, row_problem,
 )
-
-ctypedef fused real_t:
-    float
-    double
 
 
 def scan_rows(const real_t[:, ::1] data, double max_coordinate, double max_type):
-    """Find the first invalid object row ``[x, y, type]``.
+    """Find the first invalid object row ``[f_1, ..., f_d, type]`` (``d + 1 >= 2`` columns).
 
     Returns ``(problem, row)``: ``problem`` is ``RowProblem.OK`` or the first problem met, in row order.
     """
-    cdef intp_t i, row = -1
+    cdef intp_t i, row = -1, d = data.shape[1] - 1
     cdef int problem = ROW_OK
+    if d < 1:
+        raise ValueError(f"object rows need at least 2 columns [f_1, type], got {d + 1}")
     with nogil:
         for i in range(data.shape[0]):
-            problem = row_problem(data[i, 0], data[i, 1], data[i, 2], max_coordinate, max_type)
+            problem = row_problem(&data[i, 0], d, max_coordinate, max_type)
             if problem != ROW_OK:
                 row = i
                 break

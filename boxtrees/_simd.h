@@ -28,20 +28,24 @@ typedef int64_t (*boxtrees_partition_fn)(float *xs, float *ys, int32_t *sid, int
                                          const int32_t *new_id, int32_t mid, float *tmp_x,
                                          float *tmp_y, int32_t *tmp_sid);
 
-/* A node test as the traversal reads it (boxtrees._tree.NODE_DTYPE): child ids local to the
-   tree, left = -1 at a leaf (TREE_LEAF). */
+/* A node test as the traversal reads it (boxtrees._predictor.NODE_DTYPE): child ids local to
+   the tree, left = -1 at a leaf (TREE_LEAF); the box (xmin, xmax, ymin, ymax) bounds the
+   attributes x_column and y_column (the same column, with an unbounded y extent, for a box
+   over one attribute). */
 typedef struct {
     int32_t left;
     int32_t right;
     int32_t object_type;
     int32_t threshold;
+    int32_t x_column;
+    int32_t y_column;
     float box[4];
 } boxtrees_node;
 
-/* The tree-local leaf a sample reaches from root `nodes`; its objects of type t are
-   x[types[t]:types[t + 1]], and likewise y. */
-typedef int64_t (*boxtrees_find_leaf_fn)(const boxtrees_node *nodes, const float *x,
-                                         const float *y, const int64_t *types);
+/* The tree-local leaf a sample reaches from root `nodes`; attribute c of its objects of type t
+   is features[c * stride + types[t]] to features[c * stride + types[t + 1] - 1]. */
+typedef int64_t (*boxtrees_find_leaf_fn)(const boxtrees_node *nodes, const float *features,
+                                         int64_t stride, const int64_t *types);
 
 typedef struct {
     boxtrees_compact_fn compact;
@@ -118,11 +122,12 @@ static int64_t boxtrees_partition_portable(float *xs, float *ys, int32_t *sid, i
     return boxtrees_partition_finish(xs, ys, sid, nl, nr, tmp_x, tmp_y, tmp_sid);
 }
 
-static int64_t boxtrees_find_leaf_portable(const boxtrees_node *nodes, const float *x,
-                                           const float *y, const int64_t *types)
+static int64_t boxtrees_find_leaf_portable(const boxtrees_node *nodes, const float *features,
+                                           int64_t stride, const int64_t *types)
 {
     const boxtrees_node *n = nodes;
     while (n->left != -1) {
+        const float *x = features + n->x_column * stride, *y = features + n->y_column * stride;
         int32_t count = 0;
         for (int64_t k = types[n->object_type]; k < types[n->object_type + 1]; k++)
             count += (x[k] > n->box[0]) & (x[k] < n->box[1]) & (y[k] > n->box[2]) & (y[k] < n->box[3]);
@@ -202,11 +207,12 @@ static int64_t boxtrees_partition_avx512(float *xs, float *ys, int32_t *sid, int
 }
 
 __attribute__((target("avx512f")))
-static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes, const float *x,
-                                         const float *y, const int64_t *types)
+static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes, const float *features,
+                                         int64_t stride, const int64_t *types)
 {
     const boxtrees_node *n = nodes;
     while (n->left != -1) {
+        const float *x = features + n->x_column * stride, *y = features + n->y_column * stride;
         int64_t k = types[n->object_type], end = types[n->object_type + 1];
         int32_t count = 0;
         do {    /* one pass for up to 16 objects (and for none) */

@@ -7,13 +7,17 @@ __all__ = ["BoxTree", "TREE_LEAF", "TREE_UNDEFINED"]
 
 TREE_LEAF = -1
 TREE_UNDEFINED = -2
+# a tree's node arrays: the builder's, with the box over every attribute in place of the
+# builder's (column group, box over the group's columns)
+_FIELDS = tuple(name for name in NODE_FIELDS if name != "group")
 
 
 class BoxTree:
     """One fitted tree, as flat arrays indexed by node id (the root is node 0).
 
     Node ``i`` sends a sample left when the number of its objects of type ``object_type[i]``
-    strictly inside ``box[i]`` is lower than ``threshold[i]``.
+    strictly inside ``box[i]`` is lower than ``threshold[i]``. An object ``[f_1, ..., f_d,
+    type]`` is inside when every attribute lies strictly between its bounds.
 
     Attributes
     ----------
@@ -21,9 +25,11 @@ class BoxTree:
         Child node ids; ``-1`` (``TREE_LEAF``) at leaves.
     object_type : ndarray of shape (node_count,)
         Type id tested at each node; ``-2`` (``TREE_UNDEFINED``) at leaves.
-    box : ndarray of shape (node_count, 4)
-        Test box ``(xmin, xmax, ymin, ymax)``, open on every side; infinite bounds mean
-        unbounded (classic half-plane tests, feature-matrix columns). Zeros at leaves.
+    box : ndarray of shape (node_count, 2 * n_attributes)
+        Test box ``(low_1, high_1, ..., low_d, high_d)``, open on every side (for
+        objects ``[x, y, type]``: ``(xmin, xmax, ymin, ymax)``); infinite bounds mean
+        unbounded (the attributes outside the test's column group, classic half-plane
+        tests). A box bounds at most two attributes. Zeros at leaves.
     threshold : ndarray of shape (node_count,)
         Integer count threshold ``z``; ``-2`` at leaves.
     value : ndarray of shape (node_count,) or (node_count, n_outputs)
@@ -40,21 +46,35 @@ class BoxTree:
     """
 
     def __init__(self, **arrays):
-        missing = set(NODE_FIELDS) - set(arrays)
+        missing = set(_FIELDS) - set(arrays)
         if missing:
             raise TypeError(f"missing node arrays: {sorted(missing)}")
-        for name in NODE_FIELDS:
+        for name in _FIELDS:
             array = np.array(arrays[name])
             array.flags.writeable = False
             setattr(self, name, array)
 
     @classmethod
-    def from_positions(cls, arrays, types):
-        """A tree from the builder's arrays, whose tested types are positions in ``types``."""
+    def from_builder(cls, arrays, types, column_groups, n_attributes):
+        """A tree from the builder's arrays, whose tested types are positions in ``types`` and
+        whose boxes span the columns of ``column_groups[group]`` (x, then y if any)."""
         inner = arrays["children_left"] != TREE_LEAF
         arrays["object_type"] = np.where(inner, types[np.where(inner, arrays["object_type"], 0)],
                                          TREE_UNDEFINED).astype(np.int32)
+        group, box = arrays.pop("group"), arrays["box"]
+        full = np.zeros((len(box), 2 * n_attributes), dtype=box.dtype)
+        full[inner] = [-np.inf, np.inf] * n_attributes
+        for g, columns in enumerate(column_groups):
+            mine = inner & (group == g)
+            for axis, column in enumerate(columns):
+                full[mine, 2 * column:2 * column + 2] = box[mine, 2 * axis:2 * axis + 2]
+        arrays["box"] = full
         return cls(**arrays)
+
+    @property
+    def n_attributes(self):
+        """Number of object attributes the boxes bound (``d``)."""
+        return self.box.shape[1] // 2
 
     def __setstate__(self, state):
         self.__init__(**state)

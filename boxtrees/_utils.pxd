@@ -14,8 +14,8 @@ cdef enum:
     TREE_UNDEFINED = -2       # object_type / threshold of a leaf
 
 cdef enum RowProblem:
-    # what is wrong with an object row [x, y, type] (or with a batch's offsets), checked in
-    # this order; boxtrees._objects words them
+    # what is wrong with an object row [f_1, ..., f_d, type] (or with a batch's offsets),
+    # checked in this order; boxtrees._objects words them
     ROW_OK = 0
     ROW_NOT_FINITE = 1
     ROW_TOO_LARGE = 2
@@ -24,14 +24,23 @@ cdef enum RowProblem:
     ROW_TYPE_TOO_LARGE = 5
     BAD_OFFSETS = 6
 
+ctypedef fused real_t:
+    float
+    double
 
-cdef inline int row_problem(double x, double y, double t, double max_coordinate,
+
+cdef inline int row_problem(const real_t* row, intp_t n_attributes, double max_coordinate,
                             double max_type) noexcept nogil:
-    """The first ``ROW_*`` problem of one object row, or ``ROW_OK``."""
-    if not (isfinite(x) and isfinite(y) and isfinite(t)):
-        return ROW_NOT_FINITE
-    if x > max_coordinate or x < -max_coordinate or y > max_coordinate or y < -max_coordinate:
-        return ROW_TOO_LARGE
+    """The first ``ROW_*`` problem of one object row of ``n_attributes`` attributes and a
+    type, or ``ROW_OK``."""
+    cdef intp_t c
+    cdef double t = row[n_attributes]
+    for c in range(n_attributes + 1):
+        if not isfinite(row[c]):
+            return ROW_NOT_FINITE
+    for c in range(n_attributes):
+        if row[c] > max_coordinate or row[c] < -max_coordinate:
+            return ROW_TOO_LARGE
     if t < 0:
         return ROW_NEGATIVE_TYPE
     if t != floor(t):

@@ -21,59 +21,81 @@ _builder = importlib.import_module("boxtrees._builder")
 _predictor = importlib.import_module("boxtrees._predictor")
 _rows = importlib.import_module("boxtrees._rows")
 _tree = importlib.import_module("boxtrees._tree")
-_NODE_ARRAYS = _builder.NODE_FIELDS
+_NODE_ARRAYS = _tree._FIELDS
 
 
-def grow(objects, target, weight, test_type, width=0.7, n_tests=20, seed=0, refine=False):
+def grow(objects, target, weight, test_type, n_tests=20, seed=0, refine=False):
     """One tree from the builder, with small parameters."""
-    params = SimpleNamespace(test_type=test_type, test_width=width, n_tests=n_tests,
+    params = SimpleNamespace(test_type=test_type, n_tests=n_tests,
                              min_samples_split=2, max_depth=-1, max_retries=2,
                              refine_tests=refine)
     return _builder.build_tree(objects, target, weight, params, seed)
 
 
-def training_arrays(rng, n, per_sample, n_types, n_bands, spread):
-    """Random objects (``per_sample`` each, or 0 to ``-per_sample`` if negative), indexed the
-    way BoxExtraTreesRegressor does."""
+def training_arrays(rng, n, per_sample, n_types, n_bands, spread, groups):
+    """Random objects of ``1 + max column`` attributes (``per_sample`` each, or 0 to
+    ``-per_sample`` if negative), indexed the way BoxExtraTreesRegressor does: one copy per
+    column group (its x and y columns; a group of one column has one band)."""
+    d = 1 + max(max(g) for g in groups)
     sizes = np.full(n, per_sample) if per_sample >= 0 else rng.integers(0, 1 - per_sample, n)
-    data = np.column_stack([rng.uniform(-spread, spread, (sizes.sum(), 2)),
+    data = np.column_stack([rng.uniform(-spread, spread, (sizes.sum(), d)),
                             rng.integers(0, n_types, sizes.sum())]).astype(np.float32)
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.intp)
     sample = np.repeat(np.arange(n), sizes).astype(np.int32)
     edges = np.concatenate([[-np.inf], np.linspace(-1, 1, n_bands + 1)[1:-1], [np.inf]])
-    bands = np.searchsorted(edges[1:-1], data[:, 1], side="right")
-    segments = data[:, 2].astype(np.intp) * n_bands + bands
-    order = np.lexsort((data[:, 0], segments))
-    segment_ptr = np.searchsorted(segments[order], np.arange(n_types * n_bands + 1)).astype(np.intp)
-    return (data, offsets, np.ascontiguousarray(data[order, 0]), np.ascontiguousarray(data[order, 1]),
-            sample[order], segment_ptr, edges)
+    one_band = np.concatenate([[-np.inf], np.full(n_bands, np.inf)])
+    band_edges, xs, ys, samples, segments = [], [], [], [], []
+    for g, columns in enumerate(groups):
+        x = data[:, columns[0]]
+        y = data[:, columns[1]] if len(columns) == 2 else np.zeros_like(x)
+        band_edges.append(edges if len(columns) == 2 else one_band)
+        bands = np.searchsorted(band_edges[-1][1:-1], y, side="right")
+        segment = (g * n_types + data[:, d].astype(np.intp)) * n_bands + bands
+        order = np.lexsort((x, segment))
+        xs.append(x[order])
+        ys.append(y[order])
+        samples.append(sample[order])
+        segments.append(segment[order])
+    segment_ptr = np.searchsorted(np.concatenate(segments),
+                                  np.arange(len(groups) * n_types * n_bands + 1)).astype(np.intp)
+    bounds = np.tile(np.array([-1, 1, -1, 1], dtype=np.float32), (len(groups) * n_types, 1))
+    for g, columns in enumerate(groups):
+        if len(columns) == 1:
+            bounds[g * n_types:(g + 1) * n_types, 2:] = [-np.inf, np.inf]
+    objects = SimpleNamespace(x=np.concatenate(xs), y=np.concatenate(ys),
+                              sample_of=np.concatenate(samples), segment_ptr=segment_ptr,
+                              band_edges=np.array(band_edges), bounds=bounds,
+                              half_widths=np.full((len(bounds), 2), 0.7), n_groups=len(groups))
+    return data, offsets, objects
 
 
 def main():
     rng = np.random.default_rng(0)
-    for case, (n, per_sample, n_types, n_bands, spread) in enumerate(
+    xy = ((0, 1),)
+    for case, (n, per_sample, n_types, n_bands, spread, groups) in enumerate(
         # boxes hitting every sample (several times), ragged sets, no objects, objects outside
         # the bounds, two samples, more objects of a type than a SIMD step takes (16) and
-        # segments long enough to be searched
-        [(40, 6, 1, 1, 0.5), (60, -12, 3, 4, 1.0), (30, 0, 2, 3, 1.0), (50, -3, 4, 8, 5.0),
-         (2, 1, 1, 1, 1.0), (40, -60, 2, 2, 1.0)]
+        # segments long enough to be searched; objects of 3, 1 and 6 attributes
+        [(40, 6, 1, 1, 0.5, xy), (60, -12, 3, 4, 1.0, xy), (30, 0, 2, 3, 1.0, xy),
+         (50, -3, 4, 8, 5.0, xy), (2, 1, 1, 1, 1.0, xy), (40, -60, 2, 2, 1.0, xy),
+         (50, -20, 3, 4, 1.0, ((0, 1), (2,))), (40, -30, 2, 2, 1.0, ((0,),)),
+         (30, -40, 2, 3, 1.0, ((0, 1), (2, 5), (4,), (3,)))]
     ):
-        data, offsets, x, y, sample, segment_ptr, edges = training_arrays(
-            rng, n, per_sample, n_types, n_bands, spread)
+        data, offsets, objects = training_arrays(rng, n, per_sample, n_types, n_bands, spread,
+                                                 groups)
+        d = data.shape[1] - 1
         target, weight = rng.normal(size=n), rng.uniform(0.5, 2, n)
-        bounds = np.tile(np.array([-1, 1, -1, 1], dtype=np.float32), (n_types, 1))
         for test_type in ("random", "fixed", "bounded", "classic"):
             for simd in (True, False):
                 _builder._set_simd(simd)
                 _predictor._set_simd(simd)
                 # one output, then two (multi-output sums)
                 targets = target if seed_outputs(case) == 1 else np.column_stack([target, weight])
-                objects = SimpleNamespace(x=x, y=y, sample_of=sample, segment_ptr=segment_ptr,
-                                          band_edges=edges, bounds=bounds)
                 # refined tests on the first tree; zero weights drop samples in the third
                 some_zero = weight * (np.arange(n) % 3 != 1)
-                trees = [_tree.BoxTree(**grow(objects, targets, some_zero if seed == 2 else weight,
-                                              test_type, seed=seed, refine=seed == 0))
+                trees = [_tree.BoxTree.from_builder(
+                    grow(objects, targets, some_zero if seed == 2 else weight, test_type,
+                         seed=seed, refine=seed == 0), np.arange(n_types), groups, d)
                          for seed in range(3)]
                 forest = _predictor.PackedForest(trees, np.arange(n_types))
                 out = np.empty((n, forest.n_outputs))
@@ -86,15 +108,16 @@ def main():
     n, n_features = 80, 3
     values = rng.normal(size=(n, 2 * n_features)).astype(np.float32)
     bounds = np.tile(np.array([0, 0, -np.inf, np.inf], dtype=np.float32), (n_features, 1))
+    half = np.full((n_features, 2), 0.3)
     for columns in (values[:, :n_features], values[::-1, ::2], np.asfortranarray(values[:, 1::2])):
         for test_type in ("classic", "random", "fixed"):
             for local_x in (True, False):
                 for targets in (rng.normal(size=n), rng.normal(size=(n, 3))):
                     for refine in (False, True):
                         weight = rng.integers(0, 3, n).astype(float)  # zeros drop samples
-                        grow(SimpleNamespace(columns=columns, bounds=bounds, local_x=local_x),
-                             targets, weight, test_type, width=0.3, n_tests=300, seed=1,
-                             refine=refine)
+                        grow(SimpleNamespace(columns=columns, bounds=bounds, local_x=local_x,
+                                             half_widths=half, n_groups=1),
+                             targets, weight, test_type, n_tests=300, seed=1, refine=refine)
     print("kernels ok")
 
 
@@ -109,18 +132,24 @@ def corrupted_inputs(forest, trees, data, offsets):
     n = len(offsets) - 1
     out = np.empty((n, forest.n_outputs))
     rows = data.copy()
+    d = data.shape[1] - 1
     if len(rows):
-        rows[len(rows) // 2, 2] = -1000.0
+        rows[len(rows) // 2, d] = -1000.0
         assert _predictor.predict_mean(forest, rows, offsets, out)[0] != 0
-        rows[len(rows) // 2, 2] = 2.0 ** 30       # an id no tree tests: not a problem
+        rows[len(rows) // 2, d] = 2.0 ** 30       # an id no tree tests: not a problem
         assert _predictor.predict_mean(forest, rows, offsets, out)[0] == 0
+        rows[len(rows) // 3, d - 1] = np.nan      # the last attribute
+        assert _predictor.predict_mean(forest, rows, offsets, out)[0] != 0
     for bad in ([0, len(data) + 1], [-1, 0], [0, 1, 0] if len(data) else [1, 0]):
         bad = np.array(bad, dtype=np.intp)
         assert _predictor.predict_mean(forest, data, bad,
                                        np.empty((len(bad) - 1, forest.n_outputs)))[0] != 0
     raised = 0
-    for change in ({"children_left": 10**6}, {"children_left": 0}, {"object_type": 99},
-                   {"threshold": 2**40}, {"box": np.nan}, {"value": np.inf}):
+    changes = [{"children_left": 10**6}, {"children_left": 0}, {"object_type": 99},
+               {"threshold": 2**40}, {"box": np.nan}, {"value": np.inf}]
+    if d >= 3:   # a box bounding every attribute: the traversal reads at most two
+        changes.append({"box": 0.0})
+    for change in changes:
         arrays = {name: np.array(getattr(trees[0], name)) for name in _NODE_ARRAYS}
         (name, value), = change.items()
         arrays[name] = arrays[name].astype(np.float64 if name in ("box", "value") else np.int64)
@@ -130,12 +159,13 @@ def corrupted_inputs(forest, trees, data, offsets):
         except ValueError:
             raised += 1
     # a single-leaf tree has no inner node whose test or children could be bad
-    assert raised == 6 or trees[0].node_count == 1, raised
+    assert raised == len(changes) or trees[0].node_count == 1, raised
     sample = np.array(trees[0].children_left)   # not a sample id: out of range for some
     try:
         zeros = np.zeros(len(sample), np.float32)
         grow(SimpleNamespace(x=zeros, y=zeros, sample_of=sample, segment_ptr=[0, len(sample)],
-                             band_edges=[-np.inf, np.inf], bounds=np.zeros((1, 4), np.float32)),
+                             band_edges=[[-np.inf, np.inf]], bounds=np.zeros((1, 4), np.float32),
+                             half_widths=np.ones((1, 2)), n_groups=1),
              np.zeros(2), np.ones(2), "fixed")
     except ValueError:
         pass

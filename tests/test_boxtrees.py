@@ -194,10 +194,14 @@ def test_input_forms_give_identical_forests():
     packed = ObjectSets.from_sequence(sets)
     from_packed = BoxExtraTreesRegressor(**params).fit(packed, y)
     np.testing.assert_array_equal(from_list.predict(packed), from_packed.predict(sets))
-    # a 3D array is a batch of equal-size sets
+    # a 3D array may hold padding: it needs its mask, through ObjectSets.from_padded
     cube = rng.uniform(-5, 5, (50, 4, 3))
     cube[:, :, 2] = rng.integers(0, 3, (50, 4))
-    np.testing.assert_array_equal(from_list.predict(cube), from_list.predict(list(cube)))
+    with pytest.raises(ValueError, match=r"3D array.*ObjectSets\.from_padded\(X, mask\)"):
+        from_list.predict(cube)
+    mask = rng.random((50, 4)) < 0.7
+    np.testing.assert_array_equal(from_list.predict(ObjectSets.from_padded(cube, mask)),
+                                  from_list.predict([c[m] for c, m in zip(cube, mask)]))
 
 
 def test_integer_weights_act_as_repeated_samples_in_fully_grown_trees():

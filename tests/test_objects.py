@@ -22,8 +22,8 @@ def test_from_features_makes_one_object_of_each_type_per_sample(dtype):
     assert len(sets) == 2 and sets.sizes.tolist() == [3, 3]
     assert sets.data.dtype == np.float32
     np.testing.assert_array_equal(sets.data[:, 0], X.ravel().astype(np.float32))
-    assert (sets.data[:, 1] == 0).all()
-    assert sets.data[:, 2].tolist() == [0, 1, 2, 0, 1, 2]
+    assert sets.n_attributes == 1     # rows [value, type]
+    assert sets.data[:, 1].tolist() == [0, 1, 2, 0, 1, 2]
 
 
 def test_from_features_accepts_lists_and_empty_matrices():
@@ -94,6 +94,6 @@ def test_concatenate_names_the_batch_that_changed_after_it_was_built():
     with pytest.raises(ValueError, match=r"batch 2 of ObjectSets.concatenate: offsets must be"):
         ObjectSets.concatenate([A, B, bad_offsets])
     bad_shape = _copy(A)
-    bad_shape.data = np.zeros((2, 4), np.float32)
-    with pytest.raises(ValueError, match=r"rows of batch 0 .* shape \(n_objects, 3\)"):
+    bad_shape.data = np.zeros((2, 1), np.float32)
+    with pytest.raises(ValueError, match=r"rows of batch 0 .* shape \(n_objects, d \+ 1\)"):
         ObjectSets.concatenate([bad_shape])
