@@ -1,5 +1,5 @@
 """Box-test Extra-Trees: regression and classification forests over variable-size sets of
-typed 2D objects."""
+typed objects, each a row of real attributes and a type id."""
 from ._datasets import make_box_regression
 from ._extra_tree import BoxExtraTreeClassifier, BoxExtraTreeRegressor
 from ._forest import BoxExtraTreesClassifier, BoxExtraTreesRegressor

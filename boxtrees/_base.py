@@ -15,7 +15,7 @@ from sklearn.utils._param_validation import Interval, RealNotInt, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import _check_sample_weight, check_is_fitted
 
-from ._builder import TEST_KINDS, build_tree
+from ._builder import MAX_GROUP_COLUMNS, TEST_KINDS, build_tree
 from ._objects import ObjectInputMixin, check_view_bounds, row_error
 from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
@@ -364,18 +364,21 @@ class _TrainingObjects:
             half = width * (region[:, 1::2] - region[:, 0::2])      # (n_types, d)
         else:
             half = np.full((n_types, d), width)
-        # per (group, type): the region of the group's x and y columns, and the half-widths
-        self.n_groups = len(groups)
-        self.bounds = np.empty((self.n_groups * n_types, 4), dtype=np.float32)
-        self.half_widths = np.zeros((self.n_groups * n_types, 2))
+        # per (group, type): the region along the group's columns, and the half-widths; a
+        # group of one column has an unbounded y extent
+        n_groups = len(groups)
+        self.group_sizes = np.array([len(columns) for columns in groups], dtype=np.intp)
+        self.bounds = np.zeros((n_groups * n_types, 2 * MAX_GROUP_COLUMNS), dtype=np.float32)
+        self.half_widths = np.zeros((n_groups * n_types, MAX_GROUP_COLUMNS))
+        self.extra_columns = np.full((n_groups, MAX_GROUP_COLUMNS - 2), -1, dtype=np.intp)
         for g, columns in enumerate(groups):
             mine = slice(g * n_types, (g + 1) * n_types)
-            x = columns[0]
-            y = columns[1] if len(columns) == 2 else None
-            self.bounds[mine, :2] = region[:, 2 * x:2 * x + 2]
-            self.bounds[mine, 2:] = region[:, 2 * y:2 * y + 2] if y is not None else [-np.inf, np.inf]
-            self.half_widths[mine, 0] = half[:, x]
-            self.half_widths[mine, 1] = half[:, y] if y is not None else 0.0
+            for axis, column in enumerate(columns):
+                self.bounds[mine, 2 * axis:2 * axis + 2] = region[:, 2 * column:2 * column + 2]
+                self.half_widths[mine, axis] = half[:, column]
+            if len(columns) == 1:
+                self.bounds[mine, 2:4] = [-np.inf, np.inf]
+            self.extra_columns[g, :max(len(columns) - 2, 0)] = columns[2:]
         self.local_x = features and estimator.view_bounds is None
         self.columns = None
         if features:
@@ -394,10 +397,10 @@ class _TrainingObjects:
         self.band_edges = np.array([np.pad(e, (0, n_bands + 1 - len(e)), constant_values=np.inf)
                                     for e in edges])
         sample = sets.sample_index().astype(np.int32)
-        xs, ys, sample_of, segments = [], [], [], []
+        xs, ys, sample_of, segments, object_of = [], [], [], [], []
         for g, columns in enumerate(groups):
             x = data[:, columns[0]]
-            y = data[:, columns[1]] if len(columns) == 2 else np.zeros_like(x)
+            y = data[:, columns[1]] if len(columns) > 1 else np.zeros_like(x)
             bands = np.searchsorted(edges[g][1:-1], y, side="right")
             segment = (g * n_types + position) * n_bands + bands
             order = np.lexsort((x, segment))
@@ -405,9 +408,13 @@ class _TrainingObjects:
             ys.append(y[order])
             sample_of.append(sample[order])
             segments.append(segment[order])
+            object_of.append(order)
         self.x = np.ascontiguousarray(np.concatenate(xs))
         self.y = np.ascontiguousarray(np.concatenate(ys))
         self.sample_of = np.concatenate(sample_of)
+        if (self.group_sizes > 2).any():   # their further columns are read in the rows
+            self.attributes = np.ascontiguousarray(data[:, :estimator.n_attributes_])
+            self.object_of = np.concatenate(object_of).astype(np.int32)
         self.segment_ptr = np.searchsorted(
             np.concatenate(segments), np.arange(len(groups) * n_types * n_bands + 1)
         ).astype(np.intp)
@@ -415,11 +422,12 @@ class _TrainingObjects:
 
 def _column_groups(column_groups, n_attributes):
     """The column groups a test's box may span, validated: ``column_groups`` or, for None,
-    the first two attributes together and every other one alone."""
+    the first two attributes (a position), alone and with each other attribute."""
+    most = MAX_GROUP_COLUMNS
     if column_groups is None:
         if n_attributes == 1:
             return ((0,),)
-        return ((0, 1),) + tuple((c,) for c in range(2, n_attributes))
+        return ((0, 1),) + tuple((0, 1, c) for c in range(2, n_attributes))
     groups = []
     for group in column_groups:
         group = (group,) if isinstance(group, Integral) else group
@@ -427,11 +435,11 @@ def _column_groups(column_groups, n_attributes):
             group = tuple(group)
         except TypeError:
             group = None
-        if (not group or len(group) > 2
+        if (not group or len(group) > most
                 or not all(isinstance(c, Integral) and 0 <= c < n_attributes for c in group)
                 or len(set(group)) != len(group)):
             raise ValueError(
-                f"column_groups must be a non-empty sequence of groups of one or two distinct "
+                f"column_groups must be a non-empty sequence of groups of 1 to {most} distinct "
                 f"attribute indices in [0, {n_attributes}) (the objects have {n_attributes} "
                 f"attributes before their type); got {column_groups!r}"
             )

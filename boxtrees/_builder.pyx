@@ -40,6 +40,12 @@ from ._utils cimport (
 TEST_KINDS = {"random": RANDOM, "fixed": FIXED, "bounded": BOUNDED, "classic": CLASSIC}
 
 
+cdef enum:
+    MAX_GROUP = 8         # the columns a box may span: x, y and up to 6 more
+    MAX_EXTRA = 6         # MAX_GROUP - 2
+
+MAX_GROUP_COLUMNS = MAX_GROUP
+
 cdef double TIE_TOLERANCE = 1e-11
 # a feature-matrix column whose range in a node is at most this is constant there (as in
 # scikit-learn's trees): tests are not drawn on it
@@ -53,6 +59,7 @@ cdef struct BoxTest:
     coord_t xmax
     coord_t ymin
     coord_t ymax
+    coord_t extra[2 * MAX_EXTRA]   # (low, high) along the group's further columns, if any
     int32 threshold
     double proxy          # the criterion's split_proxy: larger is a lower child variance
 
@@ -62,7 +69,7 @@ cdef struct Node:         # one node of a growing tree; its values are kept besi
     intp_t children_right
     int32 object_type     # a position in the forest's types
     int32 group           # a position in the forest's column groups
-    coord_t box[4]        # over the group's columns
+    coord_t box[2 * MAX_GROUP]   # (low, high) along each of the group's columns, in order
     int32 threshold
     float64_t impurity
     intp_t n_node_samples
@@ -193,10 +200,12 @@ cdef class _Splitter:
     # segment g of the current node is lo[g]:hi[g] (object sets; a feature matrix has none)
     cdef intp_t* lo
     cdef intp_t* hi
-    # per (group, type), at ``group * n_types + type``: x0, x1, y0, y1 of its tests in the
-    # current node, and the half-widths along x and y of fixed and bounded boxes
+    # per (group, type), at ``group * n_types + type``: the region of its tests in the current
+    # node (2 * MAX_GROUP: x0, x1, y0, y1, then the further columns'), and the half-widths of
+    # fixed and bounded boxes along each column (MAX_GROUP)
     cdef double* region
     cdef const double* half
+    cdef const intp_t* group_size    # per group: its columns (1: x only, y unbounded)
     cdef intp_t* type_size           # per type: the current node's number of objects
     cdef intp_t* live                # the types tests are drawn on in the current node
     cdef intp_t n_live
@@ -219,10 +228,13 @@ cdef class _Splitter:
                   uint64 seed):
         cdef const coord_t[:, ::1] bounds = objects.bounds
         cdef intp_t n_samples = len(target), n_segments = segment_ptr.shape[0] - 1
-        cdef intp_t n_groups = objects.n_groups, n_types = bounds.shape[0] // n_groups
+        sizes = np.array(objects.group_sizes, dtype=np.intp)
+        cdef intp_t n_groups = len(sizes), n_types = bounds.shape[0] // n_groups
         half = np.array(objects.half_widths, dtype=np.float64)
-        if half.shape != (bounds.shape[0], 2):
-            raise ValueError("half_widths must be (n_groups * n_types, 2), as bounds")
+        if half.shape != (bounds.shape[0], MAX_GROUP):
+            raise ValueError(f"half_widths must be (n_groups * n_types, {MAX_GROUP}), as bounds")
+        if sizes.ndim != 1 or (sizes < 1).any() or (sizes > MAX_GROUP).any():
+            raise ValueError(f"group_sizes must be from 1 to {MAX_GROUP}")
         self._keep_alive = []
         self.order = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
         self.new_id = <int32*>self._own(np.empty(n_samples, dtype=np.int32))
@@ -242,6 +254,7 @@ cdef class _Splitter:
         self.hi = <intp_t*>self._own(np.empty(n_segments, dtype=np.intp))
         self.region = <double*>self._own(np.array(bounds, dtype=np.float64))
         self.half = <const double*>self._own(half)
+        self.group_size = <const intp_t*>self._own(sizes)
         self.type_size = <intp_t*>self._own(np.empty(n_types, dtype=np.intp))
         self.live = <intp_t*>self._own(np.arange(n_types, dtype=np.intp))
         self.n_live = n_types
@@ -285,10 +298,11 @@ cdef class _Splitter:
         """Draw a test; False when its type has no object in the node (it cannot split)."""
         cdef intp_t ty = self.live[rand_int(&self.rng, self.n_live)]
         cdef intp_t group = rand_int(&self.rng, self.n_groups) if self.n_groups > 1 else 0
-        cdef const double* r = self.region + 4 * (group * self.n_types + ty)
-        cdef const double* half = self.half + 2 * (group * self.n_types + ty)
+        cdef const double* r = self.region + 2 * MAX_GROUP * (group * self.n_types + ty)
+        cdef const double* half = self.half + MAX_GROUP * (group * self.n_types + ty)
         cdef double x0 = r[0], x1 = r[1], y0 = r[2], y1 = r[3]
         cdef bint one_dim = y0 == -INFINITY     # a group of one column: the y extent is unbounded
+        cdef intp_t n_extra = max(self.group_size[group] - 2, 0), c, axis
         cdef double a, b, h
         t.object_type = ty
         t.group = group
@@ -296,6 +310,8 @@ cdef class _Splitter:
             return False
         t.ymin = -INFINITY
         t.ymax = INFINITY
+        # the columns after x and y (a group of more than two), drawn after them: the draws of
+        # smaller groups are those of the trees grown before groups had more columns
         if self.kind == RANDOM:
             a = rand_uniform(&self.rng, x0, x1)
             b = rand_uniform(&self.rng, x0, x1)
@@ -304,13 +320,23 @@ cdef class _Splitter:
                 a = rand_uniform(&self.rng, y0, y1)
                 b = rand_uniform(&self.rng, y0, y1)
                 t.ymin, t.ymax = min(a, b), max(a, b)
+            for c in range(n_extra):
+                a = rand_uniform(&self.rng, r[4 + 2 * c], r[5 + 2 * c])
+                b = rand_uniform(&self.rng, r[4 + 2 * c], r[5 + 2 * c])
+                t.extra[2 * c], t.extra[2 * c + 1] = min(a, b), max(a, b)
         elif self.kind == CLASSIC:
             a = rand_uniform(&self.rng, x0, x1)
             t.xmin, t.xmax = -INFINITY, INFINITY
-            if one_dim or rand_int(&self.rng, 2) == 0:
+            for c in range(n_extra):
+                t.extra[2 * c], t.extra[2 * c + 1] = -INFINITY, INFINITY
+            axis = 0 if one_dim else rand_int(&self.rng, 2 + n_extra)
+            if axis == 0:
                 t.xmax = a
-            else:
+            elif axis == 1:
                 t.ymax = rand_uniform(&self.rng, y0, y1)
+            else:
+                c = axis - 2
+                t.extra[2 * c + 1] = rand_uniform(&self.rng, r[4 + 2 * c], r[5 + 2 * c])
         else:
             h = half[0]
             if self.kind == BOUNDED:
@@ -323,6 +349,12 @@ cdef class _Splitter:
                     h *= 1.0 - rand_unit(&self.rng)
                 a = rand_uniform(&self.rng, y0, y1)
                 t.ymin, t.ymax = a - h, a + h
+            for c in range(n_extra):
+                h = half[2 + c]
+                if self.kind == BOUNDED:
+                    h *= 1.0 - rand_unit(&self.rng)
+                a = rand_uniform(&self.rng, r[4 + 2 * c], r[5 + 2 * c])
+                t.extra[2 * c], t.extra[2 * c + 1] = a - h, a + h
         return True
 
     @cython.final
@@ -424,7 +456,8 @@ cdef class _Splitter:
             outer = self.candidates[m - p].first
         else:                    # nothing outside: keep the old edge if it is out there
             outer = old if old > inner else _key(
-                self.region[4 * (best.group * self.n_types + best.object_type) + side], side)
+                self.region[2 * MAX_GROUP * (best.group * self.n_types + best.object_type) + side],
+                side)
             if not outer > inner:
                 outer = nextafterf(inner, INFINITY)
         edge = <coord_t>((<double>inner + <double>outer) / 2)
@@ -497,7 +530,8 @@ cdef class _ObjectSplitter(_Splitter):
     """The splitter of object sets: the tree's own copy of the segment buffers, which split()
     partitions, and the per-sample counts of a test. Segment ``g = (group * n_types + type)
     * n_bands + band`` of the current node is ``lo[g]:hi[g]``: every column group indexes
-    all the objects, by its own x and y columns."""
+    all the objects, by its own x and y columns. A group of more columns reads the others in
+    the objects' attribute rows, through the object each entry is (``oid``)."""
     cdef coord_t* xs
     cdef coord_t* ys
     cdef int32* sid
@@ -509,6 +543,14 @@ cdef class _ObjectSplitter(_Splitter):
     cdef intp_t n_hit                # of the test being applied by split()
     cdef const float64_t* edges      # per group: its band edges, n_bands + 1, -inf to +inf
     cdef intp_t n_bands
+    # groups of more than two columns: the attributes (n_objects rows of n_attributes), the
+    # object of each entry (partitioned along with those groups' segments only), and per
+    # group the attributes of its columns after x and y (MAX_EXTRA)
+    cdef const coord_t* attributes
+    cdef intp_t n_attributes
+    cdef int32* oid
+    cdef int32* tmp_oid
+    cdef const intp_t* extra_column
 
     def __cinit__(self, objects, const intp_t[::1] segment_ptr, target, weight, params,
                   uint64 seed):
@@ -540,6 +582,26 @@ cdef class _ObjectSplitter(_Splitter):
                              "have n_groups * n_types * n_bands + 1 entries")
         self.edges = <const float64_t*>self._own(edges)
         self.n_bands = edges.shape[1] - 1
+        sizes = np.asarray(objects.group_sizes)
+        if (sizes > 2).any():
+            attributes = np.ascontiguousarray(objects.attributes, dtype=np.float32)
+            oid = np.array(objects.object_of, dtype=np.int32)
+            extra = np.array(objects.extra_columns, dtype=np.intp)
+            if attributes.ndim != 2 or oid.shape != x.shape:
+                raise ValueError("attributes must be (n_objects, n_attributes) and object_of "
+                                 "must have one entry per entry of x")
+            if oid.size and (oid.min() < 0 or oid.max() >= attributes.shape[0]):
+                raise ValueError(f"object_of must hold object rows in [0, {attributes.shape[0]})")
+            used = np.arange(MAX_EXTRA) < (sizes - 2)[:, None]
+            if (extra.shape != (self.n_groups, MAX_EXTRA)
+                    or ((extra < 0) | (extra >= attributes.shape[1]))[used].any()):
+                raise ValueError(f"extra_columns must be (n_groups, {MAX_EXTRA}) attribute "
+                                 f"indices in [0, {attributes.shape[1]})")
+            self.attributes = <const coord_t*>self._own(attributes)
+            self.n_attributes = attributes.shape[1]
+            self.oid = <int32*>self._own(oid)
+            self.tmp_oid = <int32*>self._own(np.empty(max_segment, dtype=np.int32))
+            self.extra_column = <const intp_t*>self._own(extra)
 
     cdef void _find_regions(self) noexcept nogil:
         """Tests are drawn on every type of the training set, in its region (every group
@@ -568,12 +630,20 @@ cdef class _ObjectSplitter(_Splitter):
         cdef intp_t band, g, a, e, j, n, n_hit = 0, first_band = 0, end_band = 0
         cdef intp_t first_segment = (t.group * self.n_types + t.object_type) * self.n_bands
         cdef int32 s, c, top = 0
+        cdef bint more_columns = self.group_size[t.group] > 2
         for band in range(self.n_bands):         # the bands the box overlaps, without branches
             first_band += edges[band + 1] <= ymin
             end_band += edges[band] < ymax
         for band in range(first_band, end_band):
             g = first_segment + band
-            if self.hi[g] - self.lo[g] <= SHORT_SEGMENT:
+            if more_columns:
+                # every column of the box is read, object by object, in the x strip
+                a, e = self.lo[g], self.hi[g]
+                if e - a > SHORT_SEGMENT:
+                    _strip(xs, self.lo[g], self.hi[g], t.xmin, t.xmax, &a, &e)
+                n = self._compact_columns(t, a, e)
+                inside = strip
+            elif self.hi[g] - self.lo[g] <= SHORT_SEGMENT:
                 # a short segment is tested whole, x and y at once: no search
                 n = _kernels.compact_box(xs + self.lo[g], ys + self.lo[g], sid + self.lo[g],
                                          self.hi[g] - self.lo[g], t.xmin, t.xmax, ymin, ymax,
@@ -597,6 +667,25 @@ cdef class _ObjectSplitter(_Splitter):
                 top = max(top, c + 1)
         cmax[0] = top
         return n_hit
+
+    cdef intp_t _compact_columns(self, const BoxTest* t, intp_t first, intp_t end) noexcept nogil:
+        """The sample ids of the entries ``first:end`` of a segment of a group of more than
+        two columns that lie inside the box along every column, in ``strip``; how many."""
+        cdef const intp_t* column = self.extra_column + t.group * MAX_EXTRA
+        cdef intp_t n_extra = self.group_size[t.group] - 2, j, c, n = 0
+        cdef const coord_t* row
+        cdef coord_t v
+        cdef bint inside
+        for j in range(first, end):
+            inside = ((t.xmin < self.xs[j]) & (self.xs[j] < t.xmax)
+                      & (t.ymin < self.ys[j]) & (self.ys[j] < t.ymax))
+            row = self.attributes + self.oid[j] * self.n_attributes
+            for c in range(n_extra):
+                v = row[column[c]]
+                inside &= (t.extra[2 * c] < v) & (v < t.extra[2 * c + 1])
+            self.strip[n] = self.sid[j]
+            n += inside
+        return n
 
     cdef bint evaluate(self, BoxTest* t) noexcept nogil:
         """Draw the threshold of a test and score it; False if its counts are constant."""
@@ -663,8 +752,11 @@ cdef class _ObjectSplitter(_Splitter):
         return found
 
     cdef intp_t _collect(self, const BoxTest* t, intp_t side) noexcept nogil:
-        cdef intp_t g, j, m = 0
-        cdef coord_t x, y
+        """(The edges refined are x's and y's; the further columns of a larger group keep
+        their drawn extent, and bound the candidates.)"""
+        cdef intp_t g, j, c, m = 0, n_extra = max(self.group_size[t.group] - 2, 0)
+        cdef const intp_t* column = self.extra_column + t.group * MAX_EXTRA
+        cdef coord_t x, y, v
         cdef bint inside
         cdef intp_t first_segment = (t.group * self.n_types + t.object_type) * self.n_bands
         self.candidates.resize(self.type_size[t.object_type])
@@ -673,6 +765,9 @@ cdef class _ObjectSplitter(_Splitter):
                 x, y = self.xs[j], self.ys[j]
                 inside = ((side == 0 or t.xmin < x) and (side == 1 or x < t.xmax)
                           and (side == 2 or t.ymin < y) and (side == 3 or y < t.ymax))
+                for c in range(n_extra):
+                    v = self.attributes[self.oid[j] * self.n_attributes + column[c]]
+                    inside = inside and t.extra[2 * c] < v < t.extra[2 * c + 1]
                 if inside:
                     self.candidates[m] = pair[coord_t, int32](
                         _key(x if side < 2 else y, side), self.sid[j])
@@ -724,8 +819,20 @@ cdef class _ObjectSplitter(_Splitter):
             self.counts[s] = 0
 
     cdef void _move_objects(self, int32 mid, intp_t* right_lo) noexcept nogil:
-        cdef intp_t g, j
-        for g in range(self.n_groups * self.n_types * self.n_bands):
+        cdef intp_t g, j, k, n_left, n_right, per_group = self.n_types * self.n_bands
+        for g in range(self.n_groups * per_group):
+            if self.group_size[g // per_group] > 2:
+                # the entries' objects first, while sid still holds the old sample ids
+                n_left = n_right = 0
+                for j in range(self.lo[g], self.hi[g]):
+                    if self.new_id[self.sid[j]] >= mid:
+                        self.tmp_oid[n_right] = self.oid[j]
+                        n_right += 1
+                    else:
+                        self.oid[self.lo[g] + n_left] = self.oid[j]
+                        n_left += 1
+                for k in range(n_right):
+                    self.oid[self.lo[g] + n_left + k] = self.tmp_oid[k]
             right_lo[g] = self.lo[g] + _kernels.partition(
                 self.xs + self.lo[g], self.ys + self.lo[g], self.sid + self.lo[g],
                 self.hi[g] - self.lo[g], self.new_id, mid, self.tmp_x, self.tmp_y,
@@ -791,7 +898,7 @@ cdef class _ColumnSplitter(_Splitter):
                 hi[ty] = max(hi[ty], row[ty * cs])
         self.n_live = 0
         for ty in range(self.n_types):
-            r = self.region + 4 * ty
+            r = self.region + 2 * MAX_GROUP * ty
             r[0], r[1] = lo[ty], hi[ty]
             if r[1] - r[0] > FEATURE_THRESHOLD:
                 self.live[self.n_live] = ty
@@ -977,7 +1084,8 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, vector[float64_t]* valu
         node.children_left = node.children_right = TREE_LEAF
         node.object_type = node.threshold = TREE_UNDEFINED
         node.group = 0
-        node.box[0] = node.box[1] = node.box[2] = node.box[3] = 0.0
+        for g in range(2 * MAX_GROUP):
+            node.box[g] = 0.0
         node.n_node_samples = rec.end - rec.start
         node.weighted_n_node_samples = w
         nodes.push_back(node)
@@ -1002,6 +1110,8 @@ cdef void _grow(_Splitter splitter, vector[Node]* nodes, vector[float64_t]* valu
         nodes[0][node_id].box[1] = best.xmax
         nodes[0][node_id].box[2] = best.ymin
         nodes[0][node_id].box[3] = best.ymax
+        for g in range(2 * (splitter.group_size[best.group] - 2)):
+            nodes[0][node_id].box[4 + g] = best.extra[g]
         nodes[0][node_id].threshold = best.threshold
         # the left child is pushed last so that it is grown first
         stack.push_back(StackRecord(mid, rec.end, rec.depth + 1, node_id, False))
@@ -1021,16 +1131,19 @@ def build_tree(objects, target, weight, params, uint64 seed):
     ----------
     objects : object
         The training data indexed for the builder (``boxtrees._base._TrainingObjects``).
-        A test's box spans the x and y columns of one of ``n_groups`` column groups (a group
-        of one column has no y: its y extent is unbounded). ``bounds``, shape (n_groups *
-        n_types, 4): at ``group * n_types + type``, the region ``(xmin, xmax, ymin, ymax)``
-        in which the tests of that group and type are drawn (``ymin = -inf`` marks a group
-        of one column); ``half_widths``, shape (n_groups * n_types, 2), the half-widths
-        along x and y of fixed and bounded boxes; and either
+        A test's box spans the columns of one of the column groups: ``group_sizes``, shape
+        (n_groups,), their numbers of columns, 1 to `MAX_GROUP_COLUMNS` (x, then y, then
+        further columns; a group of one column has no y: its y extent is unbounded).
+        ``bounds``, shape (n_groups * n_types, 2 * MAX_GROUP_COLUMNS): at ``group * n_types
+        + type``, the region ``(low, high)`` along each of the group's columns in which the
+        tests of that group and type are drawn (``y low = -inf`` marks a group of one
+        column); ``half_widths``, shape (n_groups * n_types, MAX_GROUP_COLUMNS), the
+        half-widths of fixed and bounded boxes along each; and either
 
         - ``columns``, a float32 feature matrix of shape (n_samples, n_types), whose column
-          ``j`` is the one object of type ``j`` of each sample (``n_groups = 1``), and
-          ``local_x``: draw the x extent of a test within its column's range in the node; or
+          ``j`` is the one object of type ``j`` of each sample (one group, of one column),
+          and ``local_x``: draw the x extent of a test within its column's range in the
+          node; or
         - ``columns = None`` (or absent) and object sets: ``x, y, sample_of``, arrays of
           shape (n_groups * n_objects,), every group's copy of the objects (its x and y
           columns) grouped by segment (group, type position, then y band), sorted by x
@@ -1038,7 +1151,11 @@ def build_tree(objects, target, weight, params, uint64 seed):
           (n_groups * n_types * n_bands + 1,): segment ``g = (group * n_types + type) *
           n_bands + band`` is ``segment_ptr[g]:segment_ptr[g + 1]``; ``band_edges``, shape
           (n_groups, n_bands + 1): band ``b`` of a group holds its objects with
-          ``band_edges[group, b] <= y < band_edges[group, b + 1]``, from -inf to +inf.
+          ``band_edges[group, b] <= y < band_edges[group, b + 1]``, from -inf to +inf. When
+          a group has more than two columns, also ``attributes``, shape (n_objects,
+          n_attributes), ``object_of``, the row of ``attributes`` of each entry of ``x``, and
+          ``extra_columns``, shape (n_groups, MAX_GROUP_COLUMNS - 2): the attributes of each
+          group's columns after x and y.
     target : array of shape (n_samples,) or (n_samples, n_outputs)
         Targets (encoded class indicators for a classifier); ``n_samples < 2**31``.
     weight : array of shape (n_samples,)
@@ -1060,9 +1177,10 @@ def build_tree(objects, target, weight, params, uint64 seed):
     n_samples = len(target)
     if len(weight) != n_samples or not 0 < n_samples < INT_MAX:
         raise ValueError(f"target and weight must have the same length, from 1 to {INT_MAX - 1}")
-    if (bounds.shape[1] != 4 or not 0 < objects.n_groups <= bounds.shape[0]
-            or bounds.shape[0] % objects.n_groups):
-        raise ValueError("bounds must be (n_groups * n_types, 4)")
+    n_groups = len(objects.group_sizes)
+    if (bounds.shape[1] != 2 * MAX_GROUP or not 0 < n_groups <= bounds.shape[0]
+            or bounds.shape[0] % n_groups):
+        raise ValueError(f"bounds must be (n_groups * n_types, {2 * MAX_GROUP})")
     if not 0 < params.n_tests <= UINT_MAX or params.max_retries < 0:
         raise ValueError(f"n_tests must be in [1, {UINT_MAX}] and max_retries >= 0")
     weight = np.array(weight, dtype=np.float64)
@@ -1075,10 +1193,10 @@ def build_tree(objects, target, weight, params, uint64 seed):
     cdef _Splitter splitter
     if getattr(objects, "columns", None) is not None:
         segment_ptr = np.zeros(1, dtype=np.intp)        # no segments
-        if objects.n_groups != 1:
-            raise ValueError("a feature matrix has one column group")
+        if list(objects.group_sizes) != [1]:
+            raise ValueError("a feature matrix has one column group, of one column")
         objects = SimpleNamespace(columns=objects.columns, bounds=objects.bounds,
-                                  half_widths=objects.half_widths, n_groups=1,
+                                  half_widths=objects.half_widths, group_sizes=[1],
                                   local_x=objects.local_x, rows=kept)
         splitter = _ColumnSplitter(objects, segment_ptr, target, weight, params, seed)
     else:
@@ -1113,7 +1231,7 @@ def _objects_of(objects, segment_ptr, kept, n_samples):
     """The objects of samples ``kept`` (sorted ids), renumbered ``0..len(kept)``, and their
     segment offsets."""
     sample_of = np.asarray(objects.sample_of, dtype=np.intp)
-    if not np.shape(objects.x) == np.shape(objects.y) == sample_of.shape == (segment_ptr[-1],):
+    if not np.shape(objects.x) == np.shape(objects.y) == sample_of.shape == (segment_ptr[len(segment_ptr) - 1],):
         raise ValueError("x, y and sample_of must have one entry per object")
     if sample_of.size and (sample_of.min() < 0 or sample_of.max() >= n_samples):
         raise ValueError(f"sample_of must hold sample ids in [0, {n_samples})")
@@ -1122,7 +1240,9 @@ def _objects_of(objects, segment_ptr, kept, n_samples):
     keep = new_id[sample_of] >= 0
     segment = np.repeat(np.arange(len(segment_ptr) - 1), np.diff(segment_ptr))
     ptr = np.concatenate([[0], np.cumsum(np.bincount(segment[keep], minlength=len(segment_ptr) - 1))])
-    return SimpleNamespace(x=np.asarray(objects.x)[keep], y=np.asarray(objects.y)[keep],
-                           sample_of=new_id[sample_of[keep]], band_edges=objects.band_edges,
-                           bounds=objects.bounds, half_widths=objects.half_widths,
-                           n_groups=objects.n_groups), ptr.astype(np.intp)
+    kept_objects = SimpleNamespace(**vars(objects))
+    kept_objects.x, kept_objects.y = np.asarray(objects.x)[keep], np.asarray(objects.y)[keep]
+    kept_objects.sample_of = new_id[sample_of[keep]]
+    if getattr(objects, "object_of", None) is not None:
+        kept_objects.object_of = np.asarray(objects.object_of)[keep]
+    return kept_objects, ptr.astype(np.intp)

@@ -74,8 +74,9 @@ class _SingleTree(BaseBoxTrees):
 
         Parameters
         ----------
-        X : sequence of array-like of shape (n_i, 3), ObjectSets, or array of shape (n_samples, n_features)
-            Object sets (rows ``[x, y, type]``; empty sets allowed), or a feature matrix.
+        X : sequence of array-like of shape (n_i, d + 1), ObjectSets, or array of shape (n_samples, n_features)
+            Object sets (rows ``[f_1, ..., f_d, type]``; empty sets allowed), or a feature
+            matrix.
         y : array-like of shape (n_samples,)
             Target values (class labels for a classifier); 2D for several outputs.
         sample_weight : array-like of shape (n_samples,), default=None
@@ -133,7 +134,7 @@ class _SingleTree(BaseBoxTrees):
 
 
 class BoxExtraTreeRegressor(RegressionTargets, _SingleTree):
-    """One Extra-Tree over sets of 2D objects, with box-count node tests.
+    """One Extra-Tree over sets of objects, with box-count node tests.
 
     The trees of `BoxExtraTreesRegressor` (its ``estimators_``) are of this class; fitting one
     with the ``random_state`` a forest gave its tree grows that same tree (unless the forest
@@ -141,7 +142,7 @@ class BoxExtraTreeRegressor(RegressionTargets, _SingleTree):
 
     Parameters
     ----------
-    n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, refine_tests
+    n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, column_groups, relative_width, refine_tests
         As in `BoxExtraTreesRegressor`.
     random_state : int, RandomState instance or None, default=None
         An int in ``[0, 2**63)`` is the seed of the tree's random generator; a RandomState
@@ -155,8 +156,12 @@ class BoxExtraTreeRegressor(RegressionTargets, _SingleTree):
         Sorted type ids seen at fit (the column indices for a feature matrix).
     n_types_ : int
         ``len(types_)``.
-    bounds_ : ndarray of shape (n_types_, 4)
-        Sampling region per type of ``types_``.
+    n_attributes_ : int
+        Number of attributes ``d`` of the objects seen at fit (1 for a feature matrix).
+    column_groups_ : tuple of tuple of int
+        The column groups the tests draw from.
+    bounds_ : ndarray of shape (n_types_, 2 * n_attributes_)
+        Sampling region per type of ``types_``, ``(low, high)`` per attribute.
     n_features_in_ : int
         Number of columns, when fitted on a feature matrix.
     feature_names_in_ : ndarray of str
@@ -177,14 +182,14 @@ class BoxExtraTreeRegressor(RegressionTargets, _SingleTree):
 
 
 class BoxExtraTreeClassifier(ClassificationTargets, _SingleTree):
-    """One Extra-Tree classifier over sets of 2D objects, with box-count node tests.
+    """One Extra-Tree classifier over sets of objects, with box-count node tests.
 
     The trees of `BoxExtraTreesClassifier` are of this class. The split criterion is the
     Gini impurity (see `BoxExtraTreesClassifier`); leaves hold class frequencies.
 
     Parameters
     ----------
-    n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, refine_tests, random_state
+    n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, column_groups, relative_width, refine_tests, random_state
         As in `BoxExtraTreeRegressor`.
 
     Attributes
@@ -195,7 +200,7 @@ class BoxExtraTreeClassifier(ClassificationTargets, _SingleTree):
         The class labels.
     n_classes_ : int or list of int
     n_outputs_ : int
-    types_, n_types_, bounds_, n_features_in_, feature_names_in_
+    types_, n_types_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_
         As in `BoxExtraTreeRegressor`.
 
     Examples

@@ -72,8 +72,9 @@ class _Forest(BaseBoxTrees):
 
         Parameters
         ----------
-        X : sequence of array-like of shape (n_i, 3), ObjectSets, or array of shape (n_samples, n_features)
-            Object sets (rows ``[x, y, type]``; empty sets allowed), or a feature matrix.
+        X : sequence of array-like of shape (n_i, d + 1), ObjectSets, or array of shape (n_samples, n_features)
+            Object sets (rows ``[f_1, ..., f_d, type]``; empty sets allowed), or a feature
+            matrix.
         y : array-like of shape (n_samples,) or (n_samples, n_outputs)
             Target values (class labels for a classifier).
         sample_weight : array-like of shape (n_samples,), default=None
@@ -162,11 +163,14 @@ class _Forest(BaseBoxTrees):
 
 
 class BoxExtraTreesRegressor(RegressionTargets, _Forest):
-    """Extra-Trees regression over sets of 2D objects, with box-count node tests.
+    """Extra-Trees regression over sets of objects, with box-count node tests.
 
-    Each sample is a set of objects ``[x, y, type]`` of any size (possibly empty). A node test
-    ``(type t, box, z)`` sends a sample left when fewer than ``z`` of its objects of type ``t``
-    lie strictly inside the box ``(xmin, xmax) x (ymin, ymax)``. Each node keeps the best of
+    Each sample is a set of objects of any size (possibly empty); an object is a row ``[f_1,
+    ..., f_d, type]`` of ``d >= 1`` real attributes and an integer type id, last (``[x, y,
+    type]`` for points in the plane). A node test ``(type t, box, z)`` sends a sample left
+    when fewer than ``z`` of its objects of type ``t`` lie strictly inside the box: an open
+    interval along each column of one of ``column_groups`` (for ``[x, y, type]`` objects,
+    ``(xmin, xmax) x (ymin, ymax)``), the other attributes unbounded. Each node keeps the best of
     ``n_tests`` random tests, scored by the weighted variance of the two children; the count
     threshold ``z`` is drawn uniformly among the integers in ``(min count, max count]`` of the
     node. Trees are grown on the full data (unless ``bootstrap``) and the forest predicts the
@@ -197,16 +201,28 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         - ``"classic"``: a random axis and a uniform split value; the box is the half-plane
           below it.
     test_width : float, default=1.0
-        Half-width (TW) for ``"fixed"`` and ``"bounded"`` tests.
+        Half-width (TW) for ``"fixed"`` and ``"bounded"`` tests, along each column of the box:
+        in the attributes' units, or with ``relative_width`` a fraction of the sampling
+        region's width along that column.
     max_retries : int, default=10
         When none of a node's ``n_tests`` tests splits it, draw up to this many further
         rounds before making it a leaf.
     max_depth : int, default=None
         Maximum tree depth; None grows until the other stopping rules apply.
-    view_bounds : array-like of 4 floats or float, default=None
-        Sampling region ``(xmin, xmax, ymin, ymax)``, or a half-width ``r`` for ``[-r, r]^2``.
+    view_bounds : array-like of 2 * d floats or float, default=None
+        Sampling region ``(low_1, high_1, ..., low_d, high_d)`` (for ``[x, y, type]``
+        objects, ``(xmin, xmax, ymin, ymax)``), or a half-width ``r`` for ``[-r, r]^d``.
         None: the bounding box of the training objects (for a feature matrix: each node's
         range of the tested column).
+    column_groups : sequence of sequences of int, default=None
+        The groups of attributes a test's box may span, each of 1 to 8 distinct attribute
+        indices (an int is a group of one); each test draws one group. None: the first two
+        attributes (a position), alone and with each other attribute, ``[(0, 1), (0, 1, 2),
+        ..., (0, 1, d - 1)]`` (``[(0,)]`` for ``d = 1``); see ``docs/boxtrees.md`` for the
+        measurements behind it.
+    relative_width : bool, default=False
+        Read ``test_width`` as a fraction of the sampling region's width along each column,
+        so that the boxes follow the units of every attribute.
     refine_tests : bool, default=False
         Refine the best of each node's tests on the node's training objects: each finite edge
         of its box is swept across the objects and moved to the tightest position of the best
@@ -241,8 +257,12 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         drawn on these types only; other ids at predict time match no test.
     n_types_ : int
         ``len(types_)``.
-    bounds_ : ndarray of shape (n_types_, 4)
-        Sampling region per type of ``types_``.
+    n_attributes_ : int
+        Number of attributes ``d`` of the objects seen at fit (1 for a feature matrix).
+    column_groups_ : tuple of tuple of int
+        The column groups the tests draw from.
+    bounds_ : ndarray of shape (n_types_, 2 * n_attributes_)
+        Sampling region per type of ``types_``, ``(low, high)`` per attribute.
     n_features_in_ : int
         Number of columns, when fitted on a feature matrix.
     feature_names_in_ : ndarray of str
@@ -284,7 +304,7 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
 
 
 class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
-    """Extra-Trees classification over sets of 2D objects, with box-count node tests.
+    """Extra-Trees classification over sets of objects, with box-count node tests.
 
     The forest of `BoxExtraTreesRegressor` with a classification criterion: the Gini
     impurity, which for class indicator targets is the variance the regressor reduces, so
@@ -295,7 +315,7 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
 
     Parameters
     ----------
-    n_estimators, n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, refine_tests, bootstrap, n_jobs, random_state, verbose
+    n_estimators, n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, column_groups, relative_width, refine_tests, bootstrap, n_jobs, random_state, verbose
         As in `BoxExtraTreesRegressor`.
 
     Attributes
@@ -306,7 +326,7 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
         The class labels, in the column order of ``predict_proba``.
     n_classes_ : int or list of int
     n_outputs_ : int
-    types_, n_types_, bounds_, n_features_in_, feature_names_in_
+    types_, n_types_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_
         As in `BoxExtraTreesRegressor`.
 
     Examples

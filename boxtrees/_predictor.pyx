@@ -1,8 +1,8 @@
 """Forest traversal: predictions and leaf indices for batches of object sets.
 
 A `PackedForest` holds the node tests of fitted trees as one array of 40-byte records (a left
-child follows its parent, so a root-to-leaf walk touches few cache lines): the box of a test
-bounds at most two of the objects' attributes, the record names which.
+child follows its parent, so a root-to-leaf walk touches few cache lines): a record names the
+two attributes its box bounds (a box over more keeps the others in a side table).
 It copies and validates the trees it is built from and keeps its arrays private, so no value
 reachable from Python can send a walk outside them.
 
@@ -17,6 +17,7 @@ import numpy as np
 
 cimport numpy as cnp
 from libc.math cimport INFINITY
+from libc.stdint cimport int16_t
 
 from ._utils cimport (
     BAD_OFFSETS, ROW_OK, ROW_TYPE_TOO_LARGE, TREE_LEAF, coord_t, float64_t, int32, intp_t,
@@ -29,11 +30,17 @@ cdef extern from "_simd.h":
         int32 right
         int32 object_type
         int32 threshold
-        int32 x_column
-        int32 y_column
+        int16_t x_column
+        int16_t y_column
+        int32 extra
         coord_t box[4]
+    ctypedef struct boxtrees_extra:
+        int32 column
+        coord_t low
+        coord_t high
     ctypedef struct boxtrees_kernels:
-        intp_t (*find_leaf)(const boxtrees_node* nodes, const coord_t* features, intp_t stride,
+        intp_t (*find_leaf)(const boxtrees_node* nodes, const boxtrees_extra* extras,
+                            const coord_t* features, intp_t stride,
                             const intp_t* types) noexcept nogil
     boxtrees_kernels boxtrees_select_kernels(int allow_simd) noexcept nogil
 
@@ -46,8 +53,12 @@ cdef enum:
 cdef double MAX_TYPE = 2.0 ** 24
 
 cdef boxtrees_node _layout
-# the traversal's node record as a NumPy dtype, read off the C struct of _simd.h
+cdef boxtrees_extra _extra_layout
+# the traversal's records as NumPy dtypes, read off the C structs of _simd.h
 NODE_DTYPE = np.asarray(<boxtrees_node[:1]>&_layout).dtype
+EXTRA_DTYPE = np.asarray(<boxtrees_extra[:1]>&_extra_layout).dtype
+# the records name attributes with int16
+MAX_ATTRIBUTES = 2**15 - 1
 
 # the traversal kernel (see _simd.h)
 cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)
@@ -72,6 +83,7 @@ def _set_simd(bint enabled):
 
 cdef struct ForestView:
     const boxtrees_node* nodes
+    const boxtrees_extra* extras
     const float64_t* value       # n_outputs per node (the prediction at leaves)
     const intp_t* tree_offsets   # first node of each tree
     intp_t n_trees
@@ -118,8 +130,7 @@ cdef class PackedForest:
     ValueError
         When a tree's arrays could send a walk anywhere but down to one of its own leaves
         (child ids out of range or not after their parent's, a tested type not in ``types``,
-        a threshold beyond int32, a NaN box bound, a box that bounds more than two
-        attributes) or hold a non-finite value.
+        a threshold beyond int32, a NaN box bound) or hold a non-finite value.
     """
 
     cdef tuple _arrays          # the private arrays behind the pointers of _view
@@ -144,6 +155,9 @@ cdef class PackedForest:
         n_attributes = per_tree[0]["box"].shape[1] // 2
         if any(a["box"].shape[1] != 2 * n_attributes for a in per_tree):
             raise ValueError("the trees of a forest must have boxes over the same attributes")
+        if n_attributes > MAX_ATTRIBUTES:
+            raise ValueError(f"boxes over {n_attributes} attributes; at most {MAX_ATTRIBUTES} "
+                             f"are supported")
         counts = np.array([len(a["value"]) for a in per_tree], dtype=np.intp)
         offsets = np.zeros(len(counts) + 1, dtype=np.intp)
         np.cumsum(counts, out=offsets[1:])
@@ -168,8 +182,6 @@ cdef class PackedForest:
             (inner & ((threshold < _INT32.min) | (threshold > _INT32.max)),
              "has a threshold outside the int32 range"),
             (inner & np.isnan(cat["box"]).any(axis=1), "has a NaN box bound"),
-            (inner & (bounded.sum(axis=1) > 2),
-             "has a box that bounds more than two attributes"),
             (~np.isfinite(cat["value"]).all(axis=1), "has a non-finite value"),
         ]
         for bad, what in problems:
@@ -182,21 +194,37 @@ cdef class PackedForest:
         nodes["right"] = np.where(inner, right, TREE_LEAF)
         nodes["object_type"] = np.where(inner, position, 0)
         nodes["threshold"] = np.where(inner, threshold, 0)
-        # a box over two attributes (or one, y unbounded; or none: everything is inside)
+        # the first two bounded attributes in the record (one: y unbounded; none: everything
+        # is inside), the others of a box in the side table
+        bounded &= inner[:, None]
+        rank = np.cumsum(bounded, axis=1)
         x_column = np.argmax(bounded, axis=1)
-        y_column = np.where(bounded.sum(axis=1) == 2,
-                            n_attributes - 1 - np.argmax(bounded[:, ::-1], axis=1), x_column)
+        y_column = np.where(rank[:, -1] >= 2, np.argmax(rank >= 2, axis=1), x_column)
         rows = np.arange(n_nodes)
         unbounded_y = (y_column == x_column)[:, None]
-        nodes["x_column"] = np.where(inner, x_column, 0)
-        nodes["y_column"] = np.where(inner, y_column, 0)
+        nodes["x_column"] = x_column
+        nodes["y_column"] = y_column
         nodes["box"] = np.column_stack([
             box[rows, x_column],
             np.where(unbounded_y, [-np.inf, np.inf], box[rows, y_column]),
         ])
+        more = np.flatnonzero(rank[:, -1] > 2)
+        node_of, column = np.nonzero(bounded[more] & (rank[more] > 2))
+        per_node = np.bincount(node_of, minlength=len(more))     # each followed by an end
+        first = np.cumsum(per_node + 1) - (per_node + 1)          # where each node's start
+        nodes["extra"] = -1
+        nodes["extra"][more] = first
+        extras = np.zeros(int((per_node + 1).sum()) + 1, dtype=EXTRA_DTYPE)
+        extras["column"] = -1                                    # (and one end of no node)
+        rank_in_node = np.arange(len(node_of)) - (np.cumsum(per_node) - per_node)[node_of]
+        slot = first[node_of] + rank_in_node
+        extras["column"][slot] = column
+        extras["low"][slot] = box[more[node_of], column, 0]
+        extras["high"][slot] = box[more[node_of], column, 1]
         value = np.ascontiguousarray(cat["value"], dtype=np.float64)
-        self._arrays = (nodes, value, offsets, types)
+        self._arrays = (nodes, extras, value, offsets, types)
         self._view.nodes = <const boxtrees_node*>cnp.PyArray_DATA(nodes)
+        self._view.extras = <const boxtrees_extra*>cnp.PyArray_DATA(extras)
         self._view.value = <const float64_t*>cnp.PyArray_DATA(value)
         self._view.tree_offsets = <const intp_t*>cnp.PyArray_DATA(offsets)
         self._view.n_trees = self.n_trees = len(counts)
@@ -304,8 +332,8 @@ cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_obje
                 mean[i] = 0.0
         for tree in range(n_trees):
             for i in range(block, block_end):
-                leaf = _kernels.find_leaf(nodes + tree_offsets[tree], features, n_objects,
-                                          type_ptr + i * stride)
+                leaf = _kernels.find_leaf(nodes + tree_offsets[tree], forest.extras, features,
+                                          n_objects, type_ptr + i * stride)
                 if mean == NULL:
                     leaves[i * n_trees + tree] = leaf
                     continue

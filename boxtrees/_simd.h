@@ -31,20 +31,30 @@ typedef int64_t (*boxtrees_partition_fn)(float *xs, float *ys, int32_t *sid, int
 /* A node test as the traversal reads it (boxtrees._predictor.NODE_DTYPE): child ids local to
    the tree, left = -1 at a leaf (TREE_LEAF); the box (xmin, xmax, ymin, ymax) bounds the
    attributes x_column and y_column (the same column, with an unbounded y extent, for a box
-   over one attribute). */
+   over one attribute). A box over more attributes bounds the others in `extra`: entries
+   extras[extra], extras[extra + 1], ... up to one whose column is -1; extra = -1: none. */
 typedef struct {
     int32_t left;
     int32_t right;
     int32_t object_type;
     int32_t threshold;
-    int32_t x_column;
-    int32_t y_column;
+    int16_t x_column;
+    int16_t y_column;
+    int32_t extra;
     float box[4];
 } boxtrees_node;
 
+/* One more bounded attribute of a box: low < value < high. */
+typedef struct {
+    int32_t column;
+    float low;
+    float high;
+} boxtrees_extra;
+
 /* The tree-local leaf a sample reaches from root `nodes`; attribute c of its objects of type t
    is features[c * stride + types[t]] to features[c * stride + types[t + 1] - 1]. */
-typedef int64_t (*boxtrees_find_leaf_fn)(const boxtrees_node *nodes, const float *features,
+typedef int64_t (*boxtrees_find_leaf_fn)(const boxtrees_node *nodes,
+                                         const boxtrees_extra *extras, const float *features,
                                          int64_t stride, const int64_t *types);
 
 typedef struct {
@@ -122,15 +132,37 @@ static int64_t boxtrees_partition_portable(float *xs, float *ys, int32_t *sid, i
     return boxtrees_partition_finish(xs, ys, sid, nl, nr, tmp_x, tmp_y, tmp_sid);
 }
 
-static int64_t boxtrees_find_leaf_portable(const boxtrees_node *nodes, const float *features,
+/* The count of a node whose box bounds more than two attributes: the objects inside the x
+   and y extents, and inside every extra extent. */
+static int32_t boxtrees_count_extra(const boxtrees_node *n, const boxtrees_extra *extras,
+                                    const float *features, int64_t stride, const int64_t *types)
+{
+    const float *x = features + n->x_column * stride, *y = features + n->y_column * stride;
+    int32_t count = 0;
+    for (int64_t k = types[n->object_type]; k < types[n->object_type + 1]; k++) {
+        int inside = (x[k] > n->box[0]) & (x[k] < n->box[1]) & (y[k] > n->box[2]) & (y[k] < n->box[3]);
+        for (const boxtrees_extra *e = extras + n->extra; e->column >= 0; e++) {
+            float v = features[e->column * stride + k];
+            inside &= (v > e->low) & (v < e->high);
+        }
+        count += inside;
+    }
+    return count;
+}
+
+static int64_t boxtrees_find_leaf_portable(const boxtrees_node *nodes,
+                                           const boxtrees_extra *extras, const float *features,
                                            int64_t stride, const int64_t *types)
 {
     const boxtrees_node *n = nodes;
     while (n->left != -1) {
         const float *x = features + n->x_column * stride, *y = features + n->y_column * stride;
         int32_t count = 0;
-        for (int64_t k = types[n->object_type]; k < types[n->object_type + 1]; k++)
-            count += (x[k] > n->box[0]) & (x[k] < n->box[1]) & (y[k] > n->box[2]) & (y[k] < n->box[3]);
+        if (n->extra >= 0)
+            count = boxtrees_count_extra(n, extras, features, stride, types);
+        else
+            for (int64_t k = types[n->object_type]; k < types[n->object_type + 1]; k++)
+                count += (x[k] > n->box[0]) & (x[k] < n->box[1]) & (y[k] > n->box[2]) & (y[k] < n->box[3]);
         n = nodes + (count < n->threshold ? n->left : n->right);
     }
     return n - nodes;
@@ -207,7 +239,8 @@ static int64_t boxtrees_partition_avx512(float *xs, float *ys, int32_t *sid, int
 }
 
 __attribute__((target("avx512f")))
-static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes, const float *features,
+static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes,
+                                         const boxtrees_extra *extras, const float *features,
                                          int64_t stride, const int64_t *types)
 {
     const boxtrees_node *n = nodes;
@@ -215,6 +248,11 @@ static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes, const float
         const float *x = features + n->x_column * stride, *y = features + n->y_column * stride;
         int64_t k = types[n->object_type], end = types[n->object_type + 1];
         int32_t count = 0;
+        if (n->extra >= 0) {
+            count = boxtrees_count_extra(n, extras, features, stride, types);
+            n = nodes + (count < n->threshold ? n->left : n->right);
+            continue;
+        }
         do {    /* one pass for up to 16 objects (and for none) */
             __mmask16 live = end - k >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << (end - k)) - 1u);
             __m512 xs = _mm512_maskz_loadu_ps(live, x + k), ys = _mm512_maskz_loadu_ps(live, y + k);

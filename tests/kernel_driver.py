@@ -44,11 +44,11 @@ def training_arrays(rng, n, per_sample, n_types, n_bands, spread, groups):
     sample = np.repeat(np.arange(n), sizes).astype(np.int32)
     edges = np.concatenate([[-np.inf], np.linspace(-1, 1, n_bands + 1)[1:-1], [np.inf]])
     one_band = np.concatenate([[-np.inf], np.full(n_bands, np.inf)])
-    band_edges, xs, ys, samples, segments = [], [], [], [], []
+    band_edges, xs, ys, samples, segments, order_of = [], [], [], [], [], []
     for g, columns in enumerate(groups):
         x = data[:, columns[0]]
-        y = data[:, columns[1]] if len(columns) == 2 else np.zeros_like(x)
-        band_edges.append(edges if len(columns) == 2 else one_band)
+        y = data[:, columns[1]] if len(columns) > 1 else np.zeros_like(x)
+        band_edges.append(edges if len(columns) > 1 else one_band)
         bands = np.searchsorted(band_edges[-1][1:-1], y, side="right")
         segment = (g * n_types + data[:, d].astype(np.intp)) * n_bands + bands
         order = np.lexsort((x, segment))
@@ -56,16 +56,24 @@ def training_arrays(rng, n, per_sample, n_types, n_bands, spread, groups):
         ys.append(y[order])
         samples.append(sample[order])
         segments.append(segment[order])
+        order_of.append(order)
     segment_ptr = np.searchsorted(np.concatenate(segments),
                                   np.arange(len(groups) * n_types * n_bands + 1)).astype(np.intp)
-    bounds = np.tile(np.array([-1, 1, -1, 1], dtype=np.float32), (len(groups) * n_types, 1))
+    width = _builder.MAX_GROUP_COLUMNS
+    bounds = np.tile(np.array([-1, 1] * width, dtype=np.float32), (len(groups) * n_types, 1))
+    extra = np.full((len(groups), width - 2), -1)
     for g, columns in enumerate(groups):
         if len(columns) == 1:
-            bounds[g * n_types:(g + 1) * n_types, 2:] = [-np.inf, np.inf]
+            bounds[g * n_types:(g + 1) * n_types, 2:4] = [-np.inf, np.inf]
+        extra[g, :max(len(columns) - 2, 0)] = columns[2:]
     objects = SimpleNamespace(x=np.concatenate(xs), y=np.concatenate(ys),
                               sample_of=np.concatenate(samples), segment_ptr=segment_ptr,
                               band_edges=np.array(band_edges), bounds=bounds,
-                              half_widths=np.full((len(bounds), 2), 0.7), n_groups=len(groups))
+                              half_widths=np.full((len(bounds), width), 0.7),
+                              group_sizes=[len(columns) for columns in groups],
+                              attributes=np.ascontiguousarray(data[:, :d]),
+                              object_of=np.concatenate(order_of).astype(np.int32),
+                              extra_columns=extra)
     return data, offsets, objects
 
 
@@ -79,7 +87,8 @@ def main():
         [(40, 6, 1, 1, 0.5, xy), (60, -12, 3, 4, 1.0, xy), (30, 0, 2, 3, 1.0, xy),
          (50, -3, 4, 8, 5.0, xy), (2, 1, 1, 1, 1.0, xy), (40, -60, 2, 2, 1.0, xy),
          (50, -20, 3, 4, 1.0, ((0, 1), (2,))), (40, -30, 2, 2, 1.0, ((0,),)),
-         (30, -40, 2, 3, 1.0, ((0, 1), (2, 5), (4,), (3,)))]
+         (30, -40, 2, 3, 1.0, ((0, 1), (2, 5), (4,), (3,))),
+         (40, -40, 2, 2, 1.0, ((0, 1, 2), (3,))), (30, -30, 3, 1, 1.0, ((4, 1, 0, 2, 3),))]
     ):
         data, offsets, objects = training_arrays(rng, n, per_sample, n_types, n_bands, spread,
                                                  groups)
@@ -107,8 +116,10 @@ def main():
     # a feature matrix, read in place whatever its strides: the column splitter
     n, n_features = 80, 3
     values = rng.normal(size=(n, 2 * n_features)).astype(np.float32)
-    bounds = np.tile(np.array([0, 0, -np.inf, np.inf], dtype=np.float32), (n_features, 1))
-    half = np.full((n_features, 2), 0.3)
+    width = _builder.MAX_GROUP_COLUMNS
+    bounds = np.zeros((n_features, 2 * width), dtype=np.float32)
+    bounds[:, 2:4] = [-np.inf, np.inf]
+    half = np.full((n_features, width), 0.3)
     for columns in (values[:, :n_features], values[::-1, ::2], np.asfortranarray(values[:, 1::2])):
         for test_type in ("classic", "random", "fixed"):
             for local_x in (True, False):
@@ -116,7 +127,7 @@ def main():
                     for refine in (False, True):
                         weight = rng.integers(0, 3, n).astype(float)  # zeros drop samples
                         grow(SimpleNamespace(columns=columns, bounds=bounds, local_x=local_x,
-                                             half_widths=half, n_groups=1),
+                                             half_widths=half, group_sizes=[1]),
                              targets, weight, test_type, n_tests=300, seed=1, refine=refine)
     print("kernels ok")
 
@@ -147,8 +158,6 @@ def corrupted_inputs(forest, trees, data, offsets):
     raised = 0
     changes = [{"children_left": 10**6}, {"children_left": 0}, {"object_type": 99},
                {"threshold": 2**40}, {"box": np.nan}, {"value": np.inf}]
-    if d >= 3:   # a box bounding every attribute: the traversal reads at most two
-        changes.append({"box": 0.0})
     for change in changes:
         arrays = {name: np.array(getattr(trees[0], name)) for name in _NODE_ARRAYS}
         (name, value), = change.items()
@@ -164,8 +173,10 @@ def corrupted_inputs(forest, trees, data, offsets):
     try:
         zeros = np.zeros(len(sample), np.float32)
         grow(SimpleNamespace(x=zeros, y=zeros, sample_of=sample, segment_ptr=[0, len(sample)],
-                             band_edges=[[-np.inf, np.inf]], bounds=np.zeros((1, 4), np.float32),
-                             half_widths=np.ones((1, 2)), n_groups=1),
+                             band_edges=[[-np.inf, np.inf]],
+                             bounds=np.zeros((1, 2 * _builder.MAX_GROUP_COLUMNS), np.float32),
+                             half_widths=np.ones((1, _builder.MAX_GROUP_COLUMNS)),
+                             group_sizes=[1]),
              np.zeros(2), np.ones(2), "fixed")
     except ValueError:
         pass

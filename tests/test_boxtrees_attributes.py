@@ -55,7 +55,7 @@ def test_objects_of_d_attributes_fit_predict_and_pickle(d, estimator_class, test
         y = y > 2
     model = _small(estimator_class, test_type=test_type, test_width=2.0).fit(X, y)
     assert model.n_attributes_ == d
-    expected_groups = ((0,),) if d == 1 else ((0, 1),) + tuple((c,) for c in range(2, d))
+    expected_groups = ((0,),) if d == 1 else ((0, 1),) + tuple((0, 1, c) for c in range(2, d))
     assert model.column_groups_ == expected_groups
     assert model.bounds_.shape == (model.n_types_, 2 * d)
     for tree in _trees(model):
@@ -63,7 +63,8 @@ def test_objects_of_d_attributes_fit_predict_and_pickle(d, estimator_class, test
         inner = tree.children_left != -1
         # every test bounds the columns of one group, and only those
         bounded = ~(np.isneginf(tree.box[inner, 0::2]) & np.isposinf(tree.box[inner, 1::2]))
-        assert (bounded.sum(axis=1) <= 2).all()
+        spans = [set(np.flatnonzero(row)) for row in bounded]
+        assert all(any(span <= set(group) for group in expected_groups) for span in spans)
     # the Cython traversal agrees with a plain walk over the exported arrays
     leaves = model.apply(X_test)
     leaves = leaves[:, None] if leaves.ndim == 1 else leaves
@@ -75,9 +76,9 @@ def test_objects_of_d_attributes_fit_predict_and_pickle(d, estimator_class, test
 
 
 def test_a_test_can_read_an_attribute_beyond_the_position():
-    # the target counts the objects of type 0 ahead (x in (0, 2)) that move forward (velocity,
-    # attribute 2, above 0.3): a box over x and the velocity, column group (0, 2), reads it;
-    # positions alone cannot tell it
+    # the target counts the objects of type 0 in a square region that move right (attribute 2):
+    # a box over the position and the velocity, column group (0, 1, 2), reads it; positions
+    # alone cannot tell it
     rng = np.random.default_rng(0)
 
     def sets(n):
@@ -85,12 +86,12 @@ def test_a_test_can_read_an_attribute_beyond_the_position():
                                  rng.integers(0, 2, k)]) for k in rng.integers(0, 15, n)]
 
     def target(s):
-        return float(((s[:, 0] > 0) & (s[:, 0] < 2) & (s[:, 2] > 0.3) & (s[:, 3] == 0)).sum())
+        return float(((np.abs(s[:, :2]).max(1) < 1.5) & (s[:, 2] > 0) & (s[:, 3] == 0)).sum())
 
     X, X_test = sets(3000), sets(600)
     y, y_test = [target(s) for s in X], [target(s) for s in X_test]
     params = dict(n_estimators=20, min_samples_split=5, test_type="random", random_state=0)
-    moving = BoxExtraTreesRegressor(**params, column_groups=[(0, 1), (0, 2)]).fit(X, y)
+    moving = BoxExtraTreesRegressor(**params, column_groups=[(0, 1, 2)]).fit(X, y)
     positions = BoxExtraTreesRegressor(**params).fit([s[:, [0, 1, 3]] for s in X], y)
     with_motion = r2_score(y_test, moving.predict(X_test))
     without = r2_score(y_test, positions.predict([s[:, [0, 1, 3]] for s in X_test]))
@@ -121,12 +122,41 @@ def test_column_groups_choose_the_columns_a_box_spans():
         np.testing.assert_array_equal(ta.box, tb.box)
 
 
-@pytest.mark.parametrize("groups", [[(0, 4)], [(0, 1, 2)], [()], [], [(1, 1)], [(-1,)], ["a"],
+@pytest.mark.parametrize("groups", [[(0, 4)], [(0, 1, 2, 3)], [()], [], [(1, 1)], [(-1,)], ["a"],
                                     [(0.5,)]])
 def test_bad_column_groups_are_rejected(groups):
     X = object_sets(np.random.default_rng(0), 50, 3)
     with pytest.raises(ValueError, match="column_groups must"):
         BoxExtraTreesRegressor(2, column_groups=groups).fit(X, np.zeros(50))
+
+
+def test_a_box_spans_at_most_eight_columns():
+    X = object_sets(np.random.default_rng(0), 50, 10)
+    BoxExtraTreesRegressor(2, column_groups=[range(8)]).fit(X, np.zeros(50))
+    with pytest.raises(ValueError, match="groups of 1 to 8 distinct attribute indices"):
+        BoxExtraTreesRegressor(2, column_groups=[range(9)]).fit(X, np.zeros(50))
+
+
+@pytest.mark.parametrize("groups", [[(0, 1, 2)], [(2, 0, 4, 1), (3,)], [(4, 3, 2, 1, 0)],
+                                    [(1, 0), (2, 3, 4)]])
+@pytest.mark.parametrize("test_type", ["fixed", "bounded", "random", "classic"])
+@pytest.mark.parametrize("refine_tests", [False, True])
+def test_boxes_over_groups_of_more_columns_walk_as_in_numpy(groups, test_type, refine_tests):
+    rng = np.random.default_rng(5)
+    X, X_test = object_sets(rng, 300, 5, max_objects=20), object_sets(rng, 80, 5)
+    y = np.array([float(((s[:, :3] > 0).all(axis=1)).sum()) for s in X])
+    forest = BoxExtraTreesRegressor(3, n_tests=30, min_samples_split=4, test_type=test_type,
+                                    test_width=2.0, column_groups=groups,
+                                    refine_tests=refine_tests, random_state=0).fit(X, y)
+    paths, starts = forest.decision_path(X)
+    reached = np.asarray(paths.sum(axis=0)).ravel()
+    for k, tree in enumerate(_trees(forest)):
+        inner = tree.children_left != -1
+        bounded = ~(np.isneginf(tree.box[inner, 0::2]) & np.isposinf(tree.box[inner, 1::2]))
+        assert bounded.sum(axis=1).max() <= max(len(g) for g in groups)
+        assert forest.apply(X_test)[:, k].tolist() == [reference_leaf(tree, s) for s in X_test]
+        # the builder split the training samples as the exported tests send them
+        np.testing.assert_array_equal(reached[starts[k]:starts[k + 1]], tree.n_node_samples)
 
 
 def test_predicting_on_objects_of_other_attributes_is_an_error():

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from boxtrees import BoxExtraTreesRegressor, BoxTree, GridCounts, ObjectSets
-from boxtrees._builder import build_tree
+from boxtrees._builder import MAX_GROUP_COLUMNS, build_tree
 from boxtrees._predictor import PackedForest, apply_leaves, predict_mean
 
 NODE_ARRAYS = ("children_left", "children_right", "object_type", "box", "threshold", "value",
@@ -75,12 +75,19 @@ def test_kernels_check_their_inputs_on_every_call(forest):
         predict_mean(object(), data, np.array([0, 4]), np.empty((1, 1)))
 
 
+def _bounds(n_types, x=(0, 0)):
+    """The builder's regions of a group of one column: x, then an unbounded y."""
+    bounds = np.zeros((n_types, 2 * MAX_GROUP_COLUMNS), np.float32)
+    bounds[:, :4] = [*x, -np.inf, np.inf]
+    return bounds
+
+
 def _build(sample_of, segment_ptr=(0, 3), n_samples=2):
     n = len(sample_of)
     objects = SimpleNamespace(x=np.zeros(n, np.float32), y=np.zeros(n, np.float32),
                               sample_of=np.asarray(sample_of), segment_ptr=list(segment_ptr),
-                              band_edges=[[-np.inf, np.inf]], bounds=np.zeros((1, 4), np.float32),
-                              half_widths=np.ones((1, 2)), n_groups=1)
+                              band_edges=[[-np.inf, np.inf]], bounds=_bounds(1),
+                              half_widths=np.ones((1, MAX_GROUP_COLUMNS)), group_sizes=[1])
     params = SimpleNamespace(test_type="fixed", n_tests=5, min_samples_split=2,
                              max_depth=-1, max_retries=1, refine_tests=False)
     return build_tree(objects, np.zeros(n_samples), np.ones(n_samples), params, 0)
@@ -120,11 +127,6 @@ def test_tree_arrays_are_read_only_and_rebuilt_trees_are_validated(forest):
         PackedForest([BoxTree(**{**arrays, "box": arrays["box"][:, :3]})], forest.types_)
     with pytest.raises(ValueError, match=r"box has shape \(\d+, 4\); \d+ nodes need"):
         PackedForest([BoxTree(**{**arrays, "box": arrays["box"][:-1]})], forest.types_)
-    # a box over three attributes: the traversal reads at most two per test
-    wide = np.tile(arrays["box"], 2)
-    wide[0] = np.arange(8)
-    with pytest.raises(ValueError, match="bounds more than two attributes"):
-        PackedForest([BoxTree(**{**arrays, "box": wide})], forest.types_)
     with pytest.raises(ValueError, match="at least one tree"):
         PackedForest([], forest.types_)
 
@@ -218,9 +220,10 @@ def test_one_object_of_a_huge_type_id_changes_neither_accuracy_nor_memory():
 
 
 def _grow_columns(columns, target, test_type="classic", local_x=True):
-    bounds = np.tile(np.array([-3, 3, -np.inf, np.inf], np.float32), (columns.shape[1], 1))
+    bounds = _bounds(columns.shape[1], [-3, 3])
     objects = SimpleNamespace(columns=columns, bounds=bounds, local_x=local_x,
-                              half_widths=np.full((len(bounds), 2), 0.5), n_groups=1)
+                              half_widths=np.full((len(bounds), MAX_GROUP_COLUMNS), 0.5),
+                              group_sizes=[1])
     params = SimpleNamespace(test_type=test_type, n_tests=30,
                              min_samples_split=2, max_depth=-1, max_retries=1, refine_tests=False)
     return build_tree(objects, target, np.ones(len(target)), params, 7)
@@ -242,8 +245,8 @@ def test_the_tree_builder_reads_a_feature_matrix_in_place_whatever_its_strides(t
     with pytest.raises(ValueError, match=r"columns must have shape \(300, 4\)"):
         _grow_columns(plain[:-1], target)
     with pytest.raises(ValueError, match=r"columns must have shape \(300, 3\)"):
-        objects = SimpleNamespace(columns=plain, bounds=np.zeros((3, 4), np.float32), local_x=True,
-                                  half_widths=np.ones((3, 2)), n_groups=1)
+        objects = SimpleNamespace(columns=plain, bounds=_bounds(3), local_x=True,
+                                  half_widths=np.ones((3, MAX_GROUP_COLUMNS)), group_sizes=[1])
         build_tree(objects, target, np.ones(300), SimpleNamespace(
             test_type="classic", n_tests=3, min_samples_split=2, max_depth=-1,
             max_retries=0, refine_tests=False), 0)
