@@ -50,8 +50,7 @@ from tqdm.auto import tqdm
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.zoo_hyperparams import ZOO_DQN  # noqa: E402
-from boxtrees import BoxExtraTreesRegressor  # noqa: E402
-from fqi import FQI, evaluate  # noqa: E402
+from fqi import FQI, evaluate, make_box_forest  # noqa: E402
 
 # Tuned DQN: rl-zoo3's settings for each env (benchmarks/zoo_hyperparams.py; policy
 # "MlpPolicy", its n_timesteps replaced by the budget below, the same for every agent).
@@ -76,8 +75,8 @@ def make_regressor(name):
     """The agent's Extra-Trees: 30 trees, nodes of fewer than 10 samples are leaves, one job."""
     if name == "fqi-sklearn":
         return ExtraTreesRegressor(n_estimators=30, min_samples_split=10, n_jobs=1)
-    return BoxExtraTreesRegressor(n_estimators=30, n_tests=10, test_type="classic",
-                                  min_samples_split=10, n_jobs=1)
+    return make_box_forest(test_type="classic", n_estimators=30, n_tests=10,
+                           min_samples_split=10, n_jobs=1)
 
 
 class Checkpoints:

@@ -124,7 +124,8 @@ def make_data(config, n_types, seed):
 def make_tree(test_type, bounds, seed):
     """A tree with the thesis parameters."""
     return BoxExtraTreeRegressor(n_tests=K, min_samples_split=N_MIN, test_type=test_type,
-                                 test_width=TEST_WIDTH, view_bounds=bounds, random_state=seed)
+                                 test_width=TEST_WIDTH, view_bounds=bounds, random_state=seed,
+                                 relative_width=False, refine_tests=False)
 
 
 def cpu_seconds(fn):

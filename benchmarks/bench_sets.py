@@ -16,10 +16,10 @@ the rest of the set is background that grows with the set size:
 
 A model that has learnt the rule keeps its accuracy at every size. Models:
 
-- ``BoxExtraTreesRegressor`` (50 trees, defaults otherwise) with each test type, its
-  prediction thresholded at 0.5, and the same forests with the estimator parameters of
-  ``--fix NAME=VALUE[,NAME=VALUE]`` (default ``FIX``; skipped, with a message, when the
-  estimator lacks one of them);
+- ``BoxExtraTreesRegressor`` (50 trees) with its defaults, and the thesis's forest
+  (``fqi.make_box_forest``) with each test type, their predictions thresholded at 0.5; the
+  thesis's forests again with the estimator parameters of ``--fix NAME=VALUE[,NAME=VALUE]``
+  (default ``FIX``; skipped, with a message, when the estimator lacks one of them);
 - scikit-learn's ``ExtraTreesClassifier`` (Gini, and entropy: what that criterion would
   change) and ``HistGradientBoostingClassifier`` on hand-made set features: per-type counts on a 10 x 10 grid, and per-type mean, minimum and
   maximum of x and y (missing when a set has no object of a type);
@@ -43,6 +43,7 @@ from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
 from boxtrees import BoxExtraTreesRegressor, GridCounts, ObjectSets
+from fqi import make_box_forest
 
 EXTENT = 10.0
 REGION = (0.5, 3.5, -0.5, 2.5)
@@ -200,10 +201,16 @@ class SetFeatures:
 
 
 class BoxForest:
-    """``BoxExtraTreesRegressor`` on the object sets, its prediction thresholded at 0.5."""
+    """A box forest on the object sets, its prediction thresholded at 0.5: the thesis's
+    forest (``fqi.make_box_forest``) with ``params`` changed, or with ``defaults`` the
+    estimator's own defaults."""
 
-    def __init__(self, n_estimators, n_jobs, seed, **params):
-        self.model = BoxExtraTreesRegressor(n_estimators, n_jobs=n_jobs, random_state=seed, **params)
+    def __init__(self, n_estimators, n_jobs, seed, defaults=False, **params):
+        if defaults:
+            self.model = BoxExtraTreesRegressor(n_estimators, n_jobs=n_jobs, random_state=seed)
+        else:
+            self.model = make_box_forest(n_estimators=n_estimators, n_jobs=n_jobs,
+                                         random_state=seed).set_params(**params)
 
     def fit(self, sets, labels):
         """Fit on a list of ``(n_i, 3)`` object arrays and their 0/1 labels; returns self."""
@@ -283,7 +290,7 @@ def unsupported(params):
 def model_factories(task, args, fix):
     """``{name: factory}`` of the models compared on ``task``; a factory builds an unfitted model."""
     n_trees, jobs, seed = args.n_trees, args.n_jobs, args.seed
-    models = {}
+    models = {"box forest (defaults)": lambda: BoxForest(n_trees, jobs, seed, defaults=True)}
     for test_type in TEST_TYPES:
         models[f"box forest ({test_type})"] = (
             lambda t=test_type: BoxForest(n_trees, jobs, seed, test_type=t))

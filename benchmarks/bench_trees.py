@@ -28,7 +28,8 @@ from sklearn.datasets import make_friedman1
 from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.metrics import r2_score
 
-from boxtrees import BoxExtraTreesRegressor, GridCounts, make_box_regression
+from boxtrees import GridCounts, make_box_regression
+from fqi import make_box_forest
 
 M, K, N_MIN = 30, 500, 30
 
@@ -54,8 +55,8 @@ def object_set_workload(n_samples, n_jobs, seed=0):
     X_test, y_test = make_box_regression(5000, random_state=seed + 1)
     rows, forests = [], {}
     for test_type in ("fixed", "random"):
-        forests[test_type] = BoxExtraTreesRegressor(
-            M, n_tests=K, min_samples_split=N_MIN, test_type=test_type, test_width=1.0,
+        forests[test_type] = make_box_forest(
+            test_type=test_type, n_estimators=M, n_tests=K, min_samples_split=N_MIN,
             n_jobs=n_jobs, random_state=seed,
         )
         rows.append(run_model(f"box forest ({test_type})", forests[test_type], X, y, X_test, y_test))
@@ -69,8 +70,8 @@ def object_set_workload(n_samples, n_jobs, seed=0):
 def dense_workload(n_jobs, seed=0):
     X, y = make_friedman1(15000, n_features=20, noise=1.0, random_state=seed)
     X, X_test, y, y_test = X[:10000], X[10000:], y[:10000], y[10000:]
-    ours = BoxExtraTreesRegressor(M, n_tests=X.shape[1], min_samples_split=N_MIN, test_type="classic",
-                                  n_jobs=n_jobs, random_state=seed)
+    ours = make_box_forest(test_type="classic", n_estimators=M, n_tests=X.shape[1],
+                           min_samples_split=N_MIN, n_jobs=n_jobs, random_state=seed)
     et = ExtraTreesRegressor(M, min_samples_split=N_MIN, max_features=1.0, n_jobs=n_jobs, random_state=seed)
     return [run_model("box forest (classic) on matrix", ours, X, y, X_test, y_test),
             run_model("sklearn ET on matrix", et, X, y, X_test, y_test)]
@@ -93,6 +94,7 @@ def single_sample_latency(forest, n_calls=2000):
 _MEMORY_SCRIPT = """
 import sys
 import numpy as np
+import json
 from boxtrees import BoxExtraTreesRegressor
 from sklearn.ensemble import ExtraTreesRegressor
 rng = np.random.default_rng(0)
@@ -100,7 +102,7 @@ X = np.empty((200_000, 50), dtype=np.float32)
 for start in range(0, len(X), 10_000):   # no float64 copy of the whole matrix
     X[start:start + 10_000] = rng.normal(size=(10_000, 50))
 y = X[:, 0] + rng.normal(size=len(X))
-model = {"ours": lambda: BoxExtraTreesRegressor(2, n_jobs=1, random_state=0),
+model = {"ours": lambda: BoxExtraTreesRegressor(**json.loads(sys.argv[2])),
          "sklearn": lambda: ExtraTreesRegressor(2, n_jobs=1, random_state=0)}.get(sys.argv[1])
 if model is not None:
     model().fit(X, y)
@@ -113,8 +115,10 @@ def dense_fit_memory():
     """Peak RSS in MB of a fresh interpreter holding the libraries and the 200,000 x 50
     matrix ("data"), and of one that also fits 2 trees on it, ours and sklearn's."""
     peaks = {}
+    # the thesis's forest (its parameters passed: the script imports no more than it uses)
+    ours = json.dumps(make_box_forest(n_estimators=2, n_jobs=1, random_state=0).get_params())
     for who in ("data", "ours", "sklearn"):
-        done = subprocess.run([sys.executable, "-c", _MEMORY_SCRIPT, who], check=True,
+        done = subprocess.run([sys.executable, "-c", _MEMORY_SCRIPT, who, ours], check=True,
                               capture_output=True, text=True)
         peaks[who] = int(done.stdout.split()[-1]) / 1024   # VmHWM is in KiB
     return peaks

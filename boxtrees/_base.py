@@ -16,7 +16,7 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import _check_sample_weight, check_is_fitted
 
 from ._builder import MAX_GROUP_COLUMNS, TEST_KINDS, build_tree
-from ._objects import ObjectInputMixin, check_view_bounds, row_error
+from ._objects import _FLOAT32_MAX, ObjectInputMixin, check_view_bounds, row_error
 from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
 from ._tree import BoxTree
@@ -28,6 +28,9 @@ _MAX_BANDS = 32
 _DEFAULT_BANDS = 8
 # counts, ids and loop bounds of the Cython core are 32-bit
 _INT32_MAX = 2**31 - 1
+# the sampling region drawn from the training objects reaches this share of their extent
+# beyond them, on every side
+_REGION_MARGIN = 0.05
 
 
 _POOLS = {}  # threads -> the prediction threads of this process
@@ -357,7 +360,7 @@ class _TrainingObjects:
         elif features:        # each column's own range
             region = np.column_stack([low, high])
         else:
-            region = np.tile(np.column_stack([low, high]).ravel(), (n_types, 1))
+            region = np.tile(_with_margin(low, high).ravel(), (n_types, 1))
         estimator.bounds_ = region.astype(np.float32)
         width = float(estimator.test_width)
         if estimator.relative_width:
@@ -418,6 +421,17 @@ class _TrainingObjects:
         self.segment_ptr = np.searchsorted(
             np.concatenate(segments), np.arange(len(groups) * n_types * n_bands + 1)
         ).astype(np.intp)
+
+
+def _with_margin(low, high):
+    """The objects' bounding box ``(low, high)`` per attribute, widened on every side by
+    `_REGION_MARGIN` of its width (of ``max(|value|, 1)`` for a constant attribute): boxes are
+    open, so a box drawn within the bounding box itself could never hold the objects that lie
+    on its border. Shape (d, 2)."""
+    low, high = np.asarray(low, dtype=np.float64), np.asarray(high, dtype=np.float64)
+    width = high - low
+    margin = _REGION_MARGIN * np.where(width > 0, width, np.maximum(np.abs(low), 1.0))
+    return np.clip(np.column_stack([low - margin, high + margin]), -_FLOAT32_MAX, _FLOAT32_MAX)
 
 
 def _column_groups(column_groups, n_attributes):

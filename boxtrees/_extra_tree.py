@@ -46,14 +46,14 @@ class _SingleTree(BaseBoxTrees):
         *,
         n_tests=500,
         min_samples_split=30,
-        test_type="fixed",
-        test_width=1.0,
+        test_type="random",
+        test_width=0.1,
         max_retries=10,
         max_depth=None,
         view_bounds=None,
         column_groups=None,
-        relative_width=False,
-        refine_tests=False,
+        relative_width=True,
+        refine_tests=True,
         random_state=None,
     ):
         self.n_tests = n_tests
@@ -173,11 +173,11 @@ class BoxExtraTreeRegressor(RegressionTargets, _SingleTree):
     >>> from boxtrees import BoxExtraTreeRegressor
     >>> X = [np.array([[0.5, 0.5, 0]]), np.array([[3.0, 3.0, 0]])] * 10
     >>> tree = BoxExtraTreeRegressor(min_samples_split=2, random_state=0).fit(X, [1.0, 0.0] * 10)
-    >>> tree.predict([np.array([[0.5, 0.5, 0]]), np.empty((0, 3))]).tolist()
+    >>> tree.predict([np.array([[0.4, 0.6, 0]]), np.array([[2.9, 2.9, 0]])]).tolist()
     [1.0, 0.0]
-    >>> # two leaves; a set with the object inside the root's box goes right (node 2)
-    >>> tree.get_n_leaves(), tree.decision_path(X[:1]).toarray().tolist()
-    (2, [[1, 0, 1]])
+    >>> # two leaves: the root's box holds the object at (3, 3), whose sets go right (node 2)
+    >>> tree.get_n_leaves(), tree.decision_path(X[:2]).toarray().tolist()
+    (2, [[1, 1, 0], [1, 0, 1]])
     """
 
 

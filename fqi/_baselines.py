@@ -36,9 +36,11 @@ def make_box_forest(env=None, *, test_type="fixed", test_width=1.0, n_estimators
                     view_bounds=None):
     """A `boxtrees.BoxExtraTreesRegressor` drawing its tests in the env's view square.
 
-    The defaults are the thesis's tuned parameters (M=30, K=500, n_min=30, fixed boxes of
-    half-width TW=1); ``test_type="classic"`` is the classic-trees baseline (axis-aligned
-    splits, also on a ``Box`` env's feature vector).
+    The thesis's forest: its tuned parameters are the defaults (M=30, K=500, n_min=30, fixed
+    boxes of half-width TW=1 in the view's units), and its tests are neither refined nor
+    grown on bootstrap samples, whatever the estimator's own defaults; ``test_type="classic"``
+    is the classic-trees baseline (axis-aligned splits, also on a ``Box`` env's feature
+    vector).
 
     Parameters
     ----------
@@ -74,6 +76,7 @@ def make_box_forest(env=None, *, test_type="fixed", test_width=1.0, n_estimators
     forest = BoxExtraTreesRegressor(
         n_estimators, n_tests=n_tests, min_samples_split=min_samples_split,
         test_type=test_type, test_width=test_width, view_bounds=view_bounds,
+        relative_width=False, refine_tests=False, bootstrap=False, max_retries=10,
         n_jobs=n_jobs, random_state=random_state)
     forest._validate_params()  # the rest, now rather than at the first fit
     return forest

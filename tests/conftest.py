@@ -34,3 +34,10 @@ def run_in_fork(check, timeout=60):
     answer = os.read(reader, 1)
     os.close(reader)
     return answer == b"1"
+
+
+# The engine as the thesis ran it (fqi.make_box_forest): fixed boxes of half-width 1 in the
+# data's units, neither refined nor grown on bootstrap samples. The engine's own tests pin it;
+# the estimators' defaults are measured elsewhere (tests/test_boxtrees_defaults.py).
+THESIS_TREE = dict(test_type="fixed", test_width=1.0, relative_width=False, refine_tests=False)
+THESIS_FOREST = dict(THESIS_TREE, bootstrap=False)

@@ -9,7 +9,13 @@ from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.metrics import r2_score
 
 from boxtrees import BoxExtraTreesRegressor, GridCounts, ObjectSets, make_box_regression
-from conftest import run_in_fork
+from conftest import THESIS_FOREST, run_in_fork
+
+
+def thesis_forest(*args, **params):
+    """A forest with the thesis's settings where ``params`` do not say otherwise."""
+    return BoxExtraTreesRegressor(*args, **{**THESIS_FOREST, **params})
+
 
 TEST_TYPES = ("fixed", "bounded", "random", "classic")
 
@@ -54,7 +60,7 @@ def traversal_kernel(request):
 def test_predict_matches_numpy_reference_traversal(test_type, traversal_kernel):
     rng = np.random.default_rng(0)
     X, y = random_sets(rng, 400), rng.normal(size=400)
-    forest = BoxExtraTreesRegressor(
+    forest = thesis_forest(
         n_estimators=7, n_tests=20, min_samples_split=4, test_type=test_type,
         test_width=1.5, random_state=0,
     ).fit(X, y)
@@ -75,7 +81,7 @@ def test_predict_matches_numpy_reference_traversal(test_type, traversal_kernel):
 def test_node_arrays_are_consistent_with_training_data():
     rng = np.random.default_rng(1)
     X, y = random_sets(rng, 300), rng.normal(size=300)
-    forest = BoxExtraTreesRegressor(n_estimators=3, n_tests=30, min_samples_split=10, random_state=0)
+    forest = thesis_forest(n_estimators=3, n_tests=30, min_samples_split=10, random_state=0)
     forest.fit(X, y)
     leaves = forest.apply(X)
     for k, tree in enumerate(trees_of(forest)):
@@ -98,7 +104,7 @@ def test_box_shapes_follow_test_type(test_type, width):
     rng = np.random.default_rng(2)
     X, y = random_sets(rng, 300, extent=8.0), rng.normal(size=300)
     bounds = (-8.0, 8.0, -6.0, 6.0)
-    forest = BoxExtraTreesRegressor(
+    forest = thesis_forest(
         n_estimators=3, n_tests=10, min_samples_split=5, test_type=test_type,
         test_width=width or 1.0, view_bounds=bounds, random_state=0,
     ).fit(X, y)
@@ -125,7 +131,7 @@ def test_box_shapes_follow_test_type(test_type, width):
 def test_fixed_box_forest_learns_box_counts_better_than_grid_extra_trees():
     X, y = make_box_regression(4000, random_state=0)
     X_test, y_test = make_box_regression(2000, random_state=1)
-    forest = BoxExtraTreesRegressor(n_estimators=20, test_type="fixed", test_width=1.0,
+    forest = thesis_forest(n_estimators=20, test_type="fixed", test_width=1.0,
                                     n_jobs=2, random_state=0).fit(X, y)
     ours = r2_score(y_test, forest.predict(X_test))
     grid = GridCounts(10).fit(X)
@@ -142,12 +148,12 @@ def test_same_seed_same_forest_whatever_n_jobs_and_after_pickling():
     X, y = make_box_regression(600, random_state=0)
     X_new, _ = make_box_regression(300, random_state=1)
     params = dict(n_estimators=6, n_tests=50, min_samples_split=10, random_state=42)
-    serial = BoxExtraTreesRegressor(n_jobs=1, **params).fit(X, y)
-    threaded = BoxExtraTreesRegressor(n_jobs=2, **params).fit(X, y)
+    serial = thesis_forest(n_jobs=1, **params).fit(X, y)
+    threaded = thesis_forest(n_jobs=2, **params).fit(X, y)
     expected = serial.predict(X_new)
     np.testing.assert_array_equal(threaded.predict(X_new), expected)
     np.testing.assert_array_equal(pickle.loads(pickle.dumps(threaded)).predict(X_new), expected)
-    other = BoxExtraTreesRegressor(n_jobs=1, **{**params, "random_state": 43}).fit(X, y)
+    other = thesis_forest(n_jobs=1, **{**params, "random_state": 43}).fit(X, y)
     assert not np.array_equal(other.predict(X_new), expected)
 
 
@@ -157,7 +163,7 @@ def test_parallel_predict_equals_serial_predict(n, n_jobs):
     # batches of a few hundred samples (one per env of a vector env) are split over threads too
     X, y = make_box_regression(500, random_state=0)
     X_new, _ = make_box_regression(n, random_state=1)
-    forest = BoxExtraTreesRegressor(n_estimators=4, n_tests=20, random_state=0).fit(X, y)
+    forest = thesis_forest(n_estimators=4, n_tests=20, random_state=0).fit(X, y)
     serial, leaves = forest.predict(X_new), forest.apply(X_new)
     forest.set_params(n_jobs=n_jobs)
     np.testing.assert_array_equal(forest.predict(X_new), serial)
@@ -167,7 +173,7 @@ def test_parallel_predict_equals_serial_predict(n, n_jobs):
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
 def test_a_forked_child_predicts_on_threads_of_its_own():
     X, y = make_box_regression(500, random_state=0)
-    forest = BoxExtraTreesRegressor(n_estimators=4, n_tests=20, n_jobs=2, random_state=0).fit(X, y)
+    forest = thesis_forest(n_estimators=4, n_tests=20, n_jobs=2, random_state=0).fit(X, y)
     expected = forest.predict(X)  # the parent's prediction threads exist before the fork
     assert run_in_fork(lambda: np.array_equal(forest.predict(X), expected))
 
@@ -176,11 +182,11 @@ def test_dask_backend_builds_the_same_forest():
     distributed = pytest.importorskip("dask.distributed")
     X, y = make_box_regression(400, random_state=0)
     params = dict(n_estimators=4, n_tests=30, min_samples_split=10, random_state=7)
-    expected = BoxExtraTreesRegressor(**params).fit(X, y).predict(X)
+    expected = thesis_forest(**params).fit(X, y).predict(X)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, distributed.Client(cluster):
         with joblib.parallel_backend("dask"):
-            forest = BoxExtraTreesRegressor(n_jobs=-1, **params).fit(X, y)
+            forest = thesis_forest(n_jobs=-1, **params).fit(X, y)
             got = forest.predict(X)
     np.testing.assert_array_equal(got, expected)
 
@@ -190,9 +196,9 @@ def test_input_forms_give_identical_forests():
     sets = random_sets(rng, 200)
     y = rng.normal(size=200)
     params = dict(n_estimators=3, n_tests=20, min_samples_split=5, random_state=0)
-    from_list = BoxExtraTreesRegressor(**params).fit(sets, y)
+    from_list = thesis_forest(**params).fit(sets, y)
     packed = ObjectSets.from_sequence(sets)
-    from_packed = BoxExtraTreesRegressor(**params).fit(packed, y)
+    from_packed = thesis_forest(**params).fit(packed, y)
     np.testing.assert_array_equal(from_list.predict(packed), from_packed.predict(sets))
     # a 3D array may hold padding: it needs its mask, through ObjectSets.from_padded
     cube = rng.uniform(-5, 5, (50, 4, 3))
@@ -212,8 +218,8 @@ def test_integer_weights_act_as_repeated_samples_in_fully_grown_trees():
     y = rng.normal(size=150)
     weights = rng.integers(0, 4, 150)
     params = dict(n_estimators=3, n_tests=20, min_samples_split=2, random_state=0)
-    weighted = BoxExtraTreesRegressor(**params).fit(sets, y, sample_weight=weights)
-    repeated = BoxExtraTreesRegressor(**params).fit(
+    weighted = thesis_forest(**params).fit(sets, y, sample_weight=weights)
+    repeated = thesis_forest(**params).fit(
         [s for s, w in zip(sets, weights) for _ in range(w)], np.repeat(y, weights)
     )
     np.testing.assert_allclose(weighted.predict(sets), repeated.predict(sets), rtol=1e-10)
@@ -226,9 +232,9 @@ def test_trees_do_not_depend_on_the_scale_of_the_weights(min_samples_split):
     y = rng.normal(size=300)
     weights = rng.uniform(0.5, 2.0, 300)
     params = dict(n_estimators=3, n_tests=20, min_samples_split=min_samples_split, random_state=0)
-    reference = BoxExtraTreesRegressor(**params).fit(sets, y, sample_weight=weights)
-    halved = BoxExtraTreesRegressor(**params).fit(sets, y, sample_weight=0.5 * weights)
-    normalised = BoxExtraTreesRegressor(**params).fit(sets, y, sample_weight=weights / weights.sum())
+    reference = thesis_forest(**params).fit(sets, y, sample_weight=weights)
+    halved = thesis_forest(**params).fit(sets, y, sample_weight=0.5 * weights)
+    normalised = thesis_forest(**params).fit(sets, y, sample_weight=weights / weights.sum())
     for other in (halved, normalised):
         for a, b in zip(trees_of(reference), trees_of(other)):
             np.testing.assert_array_equal(a.children_left, b.children_left)
@@ -243,13 +249,13 @@ def test_min_samples_split_counts_samples_or_a_fraction_of_them():
     X, y = load_diabetes(return_X_y=True)
     w = np.random.default_rng(0).uniform(0.5, 1.5, len(y))
     # fully grown trees fit the training data whatever the scale of the weights
-    forest = BoxExtraTreesRegressor(n_estimators=3, min_samples_split=2, test_type="classic",
+    forest = thesis_forest(n_estimators=3, min_samples_split=2, test_type="classic",
                                     random_state=0)
     assert forest.fit(X, y, sample_weight=w / w.sum()).score(X, y) > 0.999
     # a node of fewer than 0.1 * 442 = 44.2 samples (45, rounded up) is a leaf
     params = dict(n_estimators=2, test_type="classic", random_state=0)
-    fraction = BoxExtraTreesRegressor(min_samples_split=0.1, **params).fit(X, y)
-    count = BoxExtraTreesRegressor(min_samples_split=45, **params).fit(X, y)
+    fraction = thesis_forest(min_samples_split=0.1, **params).fit(X, y)
+    count = thesis_forest(min_samples_split=45, **params).fit(X, y)
     for tree, same in zip(trees_of(fraction), trees_of(count)):
         inner = tree.children_left != -1
         assert tree.n_node_samples[inner].min() >= 45 and inner.sum() > 5
@@ -257,17 +263,17 @@ def test_min_samples_split_counts_samples_or_a_fraction_of_them():
 
 
 def test_constant_target_and_objectless_data_give_single_leaf_trees():
-    forest = BoxExtraTreesRegressor(n_estimators=2).fit([np.empty((0, 3))] * 50, np.arange(50.0))
+    forest = thesis_forest(n_estimators=2).fit([np.empty((0, 3))] * 50, np.arange(50.0))
     assert all(t.node_count == 1 for t in trees_of(forest))
     np.testing.assert_allclose(forest.predict([np.array([[0.0, 0.0, 0]])]), 24.5)
     rng = np.random.default_rng(5)
-    forest = BoxExtraTreesRegressor(n_estimators=2).fit(random_sets(rng, 60), np.full(60, 3.0))
+    forest = thesis_forest(n_estimators=2).fit(random_sets(rng, 60), np.full(60, 3.0))
     assert all(t.node_count == 1 for t in trees_of(forest))
 
 
 def test_max_depth_limits_trees():
     X, y = make_box_regression(500, random_state=0)
-    forest = BoxExtraTreesRegressor(n_estimators=3, max_depth=3, min_samples_split=2, random_state=0).fit(X, y)
+    forest = thesis_forest(n_estimators=3, max_depth=3, min_samples_split=2, random_state=0).fit(X, y)
     assert max(t.max_depth for t in trees_of(forest)) == 3
 
 
@@ -278,10 +284,10 @@ def test_simd_and_portable_kernels_grow_identical_trees():
     params = dict(n_estimators=3, n_tests=50, min_samples_split=10, random_state=0)
     try:
         _builder._set_simd(False)
-        portable = BoxExtraTreesRegressor(test_type="random", **params).fit(X, y)
+        portable = thesis_forest(test_type="random", **params).fit(X, y)
     finally:
         _builder._set_simd(True)
-    simd = BoxExtraTreesRegressor(test_type="random", **params).fit(X, y)
+    simd = thesis_forest(test_type="random", **params).fit(X, y)
     for a, b in zip(trees_of(portable), trees_of(simd)):
         np.testing.assert_array_equal(a.children_left, b.children_left)
         np.testing.assert_array_equal(a.box, b.box)
@@ -293,7 +299,7 @@ def test_the_forest_is_a_sequence_of_tree_estimators_as_in_scikit_learn():
 
     X, y = make_box_regression(400, random_state=0)
     X_new, _ = make_box_regression(50, random_state=1)
-    forest = BoxExtraTreesRegressor(n_estimators=4, n_tests=30, min_samples_split=10,
+    forest = thesis_forest(n_estimators=4, n_tests=30, min_samples_split=10,
                                     random_state=0).fit(X, y)
     assert len(forest) == 4 and list(forest) == forest.estimators_ and forest[-1] is forest.estimators_[3]
     np.testing.assert_allclose(np.mean([tree.predict(X_new) for tree in forest], axis=0),
@@ -308,7 +314,7 @@ def test_the_forest_is_a_sequence_of_tree_estimators_as_in_scikit_learn():
 
 def test_decision_path_holds_the_nodes_from_the_root_to_the_leaf():
     X, y = make_box_regression(300, random_state=0)
-    forest = BoxExtraTreesRegressor(n_estimators=3, n_tests=20, min_samples_split=10,
+    forest = thesis_forest(n_estimators=3, n_tests=20, min_samples_split=10,
                                     random_state=0).fit(X, y)
     indicator, ptr = forest.decision_path(X[:40])
     leaves = forest.apply(X[:40])
@@ -332,12 +338,12 @@ def test_random_tests_skip_constant_columns_and_columns_of_noise_width():
     X[:, 500] = rng.normal(size=300)
     y = 3 * X[:, 500]
     # one test per node: a draw on any of the 1000 constant columns would make a leaf
-    forest = BoxExtraTreesRegressor(3, n_tests=1, max_retries=0, test_type="classic",
+    forest = thesis_forest(3, n_tests=1, max_retries=0, test_type="classic",
                                     min_samples_split=2, random_state=0).fit(X, y)
     assert forest.score(X, y) > 0.999
     assert {int(t) for e in forest for t in e.tree_.object_type if t >= 0} == {500}
     # a column whose range is below 1e-7 is constant, as in scikit-learn's trees
     X = np.column_stack([rng.uniform(0, 5e-8, 300), rng.normal(size=300)])
-    forest = BoxExtraTreesRegressor(3, n_tests=5, test_type="classic", min_samples_split=2,
+    forest = thesis_forest(3, n_tests=5, test_type="classic", min_samples_split=2,
                                     random_state=0).fit(X, X[:, 0] * 1e7 + X[:, 1])
     assert all(0 not in e.tree_.object_type for e in forest)

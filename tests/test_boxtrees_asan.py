@@ -31,7 +31,7 @@ def test_kernels_have_no_invalid_memory_access_under_address_sanitizer(tmp_path)
                     ignore=shutil.ignore_patterns("*.so", "*.cpp", "__pycache__"))
     shutil.copy(ROOT / "setup.py", tmp_path)
     (tmp_path / "tests").mkdir()
-    for script in ("kernel_driver.py", "test_boxtrees_safety.py"):
+    for script in ("conftest.py", "kernel_driver.py", "test_boxtrees_safety.py"):
         shutil.copy(ROOT / "tests" / script, tmp_path / "tests")
     sanitize = "-fsanitize=address -fno-omit-frame-pointer"
     build = subprocess.run(

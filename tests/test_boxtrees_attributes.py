@@ -146,7 +146,7 @@ def test_boxes_over_groups_of_more_columns_walk_as_in_numpy(groups, test_type, r
     X, X_test = object_sets(rng, 300, 5, max_objects=20), object_sets(rng, 80, 5)
     y = np.array([float(((s[:, :3] > 0).all(axis=1)).sum()) for s in X])
     forest = BoxExtraTreesRegressor(3, n_tests=30, min_samples_split=4, test_type=test_type,
-                                    test_width=2.0, column_groups=groups,
+                                    test_width=0.2, column_groups=groups, bootstrap=False,
                                     refine_tests=refine_tests, random_state=0).fit(X, y)
     paths, starts = forest.decision_path(X)
     reached = np.asarray(paths.sum(axis=0)).ravel()

@@ -5,8 +5,9 @@ import pytest
 from boxtrees import (
     BoxExtraTreeClassifier, BoxExtraTreesClassifier, BoxExtraTreesRegressor, make_box_regression,
 )
+from conftest import THESIS_FOREST, THESIS_TREE
 
-PARAMS = dict(n_estimators=4, n_tests=30, min_samples_split=10, random_state=0)
+PARAMS = dict(THESIS_FOREST, n_estimators=4, n_tests=30, min_samples_split=10, random_state=0)
 
 
 def presence(sets, region_type=0):
@@ -79,7 +80,7 @@ def test_classifier_weights_and_a_single_tree(data):
     # up-weighting the positives raises their probabilities at leaves holding both classes
     plain = BoxExtraTreesClassifier(**PARAMS).fit(X, labels)
     assert weighted.predict_proba(X)[:, 1].mean() > plain.predict_proba(X)[:, 1].mean()
-    tree = BoxExtraTreeClassifier(min_samples_split=2, random_state=0).fit(X, labels)
+    tree = BoxExtraTreeClassifier(**THESIS_TREE, min_samples_split=2, random_state=0).fit(X, labels)
     assert tree.score(X, labels) == 1.0 and tree.get_n_leaves() > 10
     with np.errstate(divide="ignore"):
         np.testing.assert_array_equal(np.log(tree.predict_proba(X[:5])), tree.predict_log_proba(X[:5]))

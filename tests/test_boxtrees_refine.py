@@ -6,6 +6,7 @@ import pytest
 from benchmarks.bench_sets import make_data
 from boxtrees import (BoxExtraTreeRegressor, BoxExtraTreesClassifier, BoxExtraTreesRegressor,
                       make_box_regression)
+from conftest import THESIS_FOREST, THESIS_TREE
 
 
 def accuracy(forest, sets, labels):
@@ -17,12 +18,13 @@ def accuracy(forest, sets, labels):
 def test_refined_forests_keep_their_accuracy_on_sets_15_times_larger(task, test_type):
     # (the refined edges need the data: with 1,000 sets the compare task falls to .6-.9)
     (train, labels), tests = make_data(task, n_train=4000, n_test=300, seed=0)
-    params = dict(n_estimators=30, test_type=test_type, random_state=0, n_jobs=1)
+    params = dict(THESIS_FOREST, n_estimators=30, test_type=test_type, random_state=0, n_jobs=1)
     plain = BoxExtraTreesRegressor(**params).fit(train, labels)
-    fixed = BoxExtraTreesRegressor(**params, refine_tests=True, bootstrap=True).fit(train, labels)
+    fixed = BoxExtraTreesRegressor(**{**params, "refine_tests": True, "bootstrap": True}).fit(
+        train, labels)
     at_20, at_300 = accuracy(fixed, *tests[20]), accuracy(fixed, *tests[300])
     assert at_20 > 0.95 and at_300 > at_20 - 0.03, (at_20, at_300)
-    # the defaults lose it, so the sets are large enough to tell
+    # the thesis's settings lose it, so the sets are large enough to tell
     assert accuracy(plain, *tests[300]) < at_300 - 0.05
 
 
@@ -30,8 +32,9 @@ def test_refined_splits_send_samples_both_ways_and_fit_better():
     X, y = make_box_regression(1500, random_state=0)
     X_test, y_test = make_box_regression(1000, random_state=1)
     for test_type in ("fixed", "bounded", "random", "classic"):
-        params = dict(n_estimators=5, test_type=test_type, min_samples_split=5, random_state=0)
-        refined = BoxExtraTreesRegressor(**params, refine_tests=True).fit(X, y)
+        params = dict(THESIS_FOREST, n_estimators=5, test_type=test_type, min_samples_split=5,
+                      random_state=0)
+        refined = BoxExtraTreesRegressor(**{**params, "refine_tests": True}).fit(X, y)
         for tree in refined:
             t = tree.tree_
             inner = t.children_left >= 0
@@ -61,7 +64,7 @@ def test_refinement_on_a_feature_matrix_moves_edges_to_the_data():
 
 def test_a_bootstrap_tree_is_the_tree_of_its_draw_as_weights():
     X, y = make_box_regression(300, random_state=0)
-    params = dict(n_tests=50, min_samples_split=5, view_bounds=5.0)
+    params = dict(THESIS_TREE, n_tests=50, min_samples_split=5, view_bounds=5.0)
     forest = BoxExtraTreesRegressor(3, bootstrap=True, random_state=0, **params).fit(X, y)
     for tree in forest:
         seed = tree.random_state
@@ -70,7 +73,7 @@ def test_a_bootstrap_tree_is_the_tree_of_its_draw_as_weights():
         alone = BoxExtraTreeRegressor(random_state=seed, **params).fit(X, y, sample_weight=counts)
         np.testing.assert_array_equal(tree.predict(X), alone.predict(X))
         assert tree.tree_.n_node_samples[0] == (counts > 0).sum()
-    plain = BoxExtraTreesRegressor(3, random_state=0, **params).fit(X, y)
+    plain = BoxExtraTreesRegressor(3, random_state=0, bootstrap=False, **params).fit(X, y)
     assert not np.array_equal(plain.predict(X), forest.predict(X))
 
 

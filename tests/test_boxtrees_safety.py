@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 from boxtrees import BoxExtraTreesRegressor, BoxTree, GridCounts, ObjectSets
 from boxtrees._builder import MAX_GROUP_COLUMNS, build_tree
+from conftest import THESIS_FOREST
 from boxtrees._predictor import PackedForest, apply_leaves, predict_mean
 
 NODE_ARRAYS = ("children_left", "children_right", "object_type", "box", "threshold", "value",
@@ -256,8 +257,8 @@ def test_fit_on_a_feature_matrix_needs_memory_for_its_samples_not_a_copy_of_the_
     rng = np.random.default_rng(0)
     X = rng.normal(size=(40_000, 50)).astype(np.float32)      # 8 MB
     y = X[:, 0] - X[:, 1]
-    forest = BoxExtraTreesRegressor(2, n_tests=50, test_type="classic", min_samples_split=2000,
-                                    random_state=0, n_jobs=1)
+    forest = BoxExtraTreesRegressor(2, **{**THESIS_FOREST, "test_type": "classic"}, n_tests=50,
+                                    min_samples_split=2000, random_state=0, n_jobs=1)
     tracemalloc.start()
     forest.fit(X, y)
     peak = tracemalloc.get_traced_memory()[1]

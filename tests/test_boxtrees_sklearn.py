@@ -11,15 +11,18 @@ from boxtrees import (
 )
 
 TEST_TYPES = ("fixed", "bounded", "random", "classic")
+# the thesis's engine: widths in the data's units, no refinement, no bootstrap
+PLAIN = dict(relative_width=False, refine_tests=False)
 ESTIMATORS = (
+    # the defaults (refined tests, bootstrap forests), with each test type
     [BoxExtraTreesRegressor(n_estimators=5, test_type=t, random_state=0) for t in TEST_TYPES]
     + [BoxExtraTreeRegressor(test_type=t, random_state=0) for t in TEST_TYPES]
     + [BoxExtraTreesClassifier(n_estimators=5, test_type=t, random_state=0) for t in TEST_TYPES]
     + [BoxExtraTreeClassifier(test_type=t, random_state=0) for t in TEST_TYPES]
-    # the size-robust options
-    + [Forest(n_estimators=5, refine_tests=True, bootstrap=True, random_state=0)
-       for Forest in (BoxExtraTreesRegressor, BoxExtraTreesClassifier)]
-    + [BoxExtraTreeRegressor(refine_tests=True, random_state=0)]
+    # the thesis's settings
+    + [Forest(n_estimators=5, test_type=t, bootstrap=False, random_state=0, **PLAIN)
+       for Forest in (BoxExtraTreesRegressor, BoxExtraTreesClassifier) for t in TEST_TYPES]
+    + [BoxExtraTreeRegressor(test_type="fixed", random_state=0, **PLAIN)]
     + [GridCounts(n_bins=4)]
 )
 
