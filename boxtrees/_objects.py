@@ -41,6 +41,26 @@ def row_error(problem, row, data, what="object sets"):
     return ValueError(f"{what} {_ROW_PROBLEMS[problem]} (object row {row}: {data[row].tolist()})")
 
 
+def _check_type_names(type_names, data):
+    """Validate the labels of a batch's type ids: one for each id its rows use."""
+    if type_names is None:
+        return None
+    names = np.asarray(type_names)
+    if names.ndim != 1 or len(np.unique(names)) != len(names):
+        raise ValueError("type_names must be a 1D sequence of distinct labels")
+    if len(data) and data[:, -1].max() >= len(names):
+        raise ValueError(f"the objects have type ids up to {int(data[:, -1].max())}, but "
+                         f"type_names names {len(names)} types")
+    return names
+
+
+def _same_names(a, b):
+    """Whether two batches' ``type_names`` are the same (both None, or equal labels)."""
+    if a is None or b is None:
+        return a is None and b is None
+    return len(a) == len(b) and bool((np.asarray(a) == np.asarray(b)).all())
+
+
 def _check_offsets(offsets, n_rows):
     """Validate batch offsets and return them as a C-contiguous intp array."""
     offsets = np.asarray(offsets)
@@ -102,6 +122,15 @@ class ObjectSets:
         types non-negative integers.
     offsets : array-like of int of shape (n_sets + 1,)
         Non-decreasing, starting at 0 and ending at ``n_objects``.
+    type_names : array-like of shape (n_names,), default=None
+        The label of each type id (id ``t`` is ``type_names[t]``), when the types are named
+        (`from_frame` names them); the estimators keep the names seen at fit and read the
+        ids of a named batch through them.
+
+    Attributes
+    ----------
+    data, offsets, type_names
+        As given (validated).
 
     Examples
     --------
@@ -112,18 +141,107 @@ class ObjectSets:
     (2, [1, 0], 2)
     """
 
-    __slots__ = ("data", "offsets")
+    __slots__ = ("data", "offsets", "type_names")
 
-    def __init__(self, data, offsets):
+    def __init__(self, data, offsets, type_names=None):
         self.data = _check_rows(data)
         self.offsets = _check_offsets(offsets, len(self.data))
+        self.type_names = _check_type_names(type_names, self.data)
 
     @classmethod
-    def _trusted(cls, data, offsets):
+    def _trusted(cls, data, offsets, type_names=None):
         """Wrap arrays that are already valid (internal: no checks, no copies)."""
         self = cls.__new__(cls)
-        self.data, self.offsets = data, offsets
+        self.data, self.offsets, self.type_names = data, offsets, type_names
         return self
+
+    @classmethod
+    def from_frame(cls, frame, *, sample, columns, type, samples=None):
+        """Build from a long table, one row per object: a data frame, or any mapping from
+        column names to equal-length columns (pandas, polars, a dict of arrays).
+
+        Parameters
+        ----------
+        frame : data frame or mapping of str to array-like
+            One row per object.
+        sample : str
+            The column of the sample (set) each object belongs to: any hashable ids.
+        columns : sequence of str
+            The object's attribute columns, in order (``d = len(columns)``).
+        type : str
+            The column of the object types: labels of any kind (strings, categories) are
+            named, their ids their positions in the sorted labels (`type_names`); integers
+            ``>= 0`` are type ids themselves.
+        samples : array-like, default=None
+            Every sample id, in the order of the sets: samples without objects become empty
+            sets (a group-by drops them). None: the ids present, sorted.
+
+        Returns
+        -------
+        ObjectSets
+
+        Raises
+        ------
+        ValueError
+            If a column is missing or holds bad values, or an object's sample is not in
+            ``samples``.
+
+        Examples
+        --------
+        >>> from boxtrees import ObjectSets
+        >>> frame = {"frame": [7, 7, 9], "x": [0.5, 2.0, 1.0], "y": [1.0, 0.0, 3.0],
+        ...          "label": ["car", "person", "car"]}
+        >>> sets = ObjectSets.from_frame(frame, sample="frame", columns=["x", "y"],
+        ...                              type="label", samples=[7, 8, 9])
+        >>> sets.sizes.tolist(), sets.type_names.tolist(), sets[0].tolist()
+        ([2, 0, 1], ['car', 'person'], [[0.5, 1.0, 0.0], [2.0, 0.0, 1.0]])
+        """
+        if isinstance(columns, str):
+            raise TypeError(f"columns must be a sequence of column names, got the string "
+                            f"{columns!r}; wrap one name in a list")
+        names = [sample, *columns, type]
+        read = {}
+        for name in names:
+            try:
+                read[name] = np.asarray(frame[name])
+            except (KeyError, IndexError, TypeError, ValueError):
+                raise ValueError(f"the frame has no column {name!r}") from None
+        lengths = {len(column) for column in read.values()}
+        if len(lengths) != 1 or any(column.ndim != 1 for column in read.values()):
+            raise ValueError(f"the columns {names} must be 1D and of one length")
+        if not columns:
+            raise ValueError("columns must name at least one attribute column")
+        attributes = np.column_stack([read[name] for name in columns])
+        if attributes.dtype.kind not in "biuf":
+            raise TypeError(f"the attribute columns {list(columns)} must hold real numbers, "
+                            f"got dtype {attributes.dtype}")
+        labels = read[type]
+        type_names = None
+        if labels.dtype.kind in "biu" or (labels.dtype.kind == "f" and labels.size
+                                          and np.isfinite(labels).all()
+                                          and (labels == np.floor(labels)).all()):
+            ids = labels
+        else:
+            if labels.size and any(label is None or label != label for label in labels):
+                raise ValueError(f"the type column {type!r} has missing labels")
+            type_names, ids = np.unique(labels, return_inverse=True)
+        ids_of_samples = read[sample]
+        known = np.unique(ids_of_samples) if samples is None else np.asarray(samples)
+        if known.ndim != 1 or len(np.unique(known)) != len(known):
+            raise ValueError("samples must be a 1D sequence of distinct sample ids")
+        order = np.argsort(known, kind="stable")
+        set_of = np.zeros(len(ids_of_samples), dtype=np.intp)
+        found = np.zeros(len(ids_of_samples), dtype=bool)
+        if len(known):
+            position = np.minimum(np.searchsorted(known[order], ids_of_samples), len(known) - 1)
+            set_of, found = order[position], known[order][position] == ids_of_samples
+        if not found.all():
+            raise ValueError(f"objects of sample {ids_of_samples[~found][0].item()!r} are in the "
+                             f"frame, but that sample is not in samples")
+        rows = np.argsort(set_of, kind="stable")        # objects in set order, then row order
+        data = np.column_stack([attributes, np.asarray(ids, dtype=np.float64)])[rows]
+        sizes = np.bincount(set_of, minlength=len(known))
+        return cls(data.reshape(-1, len(columns) + 1), _offsets_from_sizes(sizes), type_names)
 
     @classmethod
     def from_sequence(cls, sets):
@@ -329,7 +447,12 @@ class ObjectSets:
             data = [rows if len(rows) else rows.reshape(0, width[1]) for rows in data]
         else:
             data = [np.empty((0, data[0].shape[1]), dtype=np.float32)]
-        return cls._trusted(np.concatenate(data), _offsets_from_sizes(np.concatenate(sizes)))
+        names = batches[0].type_names
+        if any(not _same_names(batch.type_names, names) for batch in batches):
+            raise ValueError("the batches of ObjectSets.concatenate must name their types alike "
+                             "(the same type_names, or none)")
+        return cls._trusted(np.concatenate(data), _offsets_from_sizes(np.concatenate(sizes)),
+                            names)
 
     def __len__(self):
         return len(self.offsets) - 1
@@ -367,7 +490,8 @@ class ObjectSets:
             if step == 1:
                 stop = max(start, stop)
                 offsets = self.offsets[start : stop + 1]
-                return ObjectSets._trusted(self.data[offsets[0] : offsets[-1]], offsets - offsets[0])
+                return ObjectSets._trusted(self.data[offsets[0] : offsets[-1]], offsets - offsets[0],
+                                           self.type_names)
             index = np.arange(start, stop, step)
         index = np.asarray(index)
         if index.dtype == bool:
@@ -382,7 +506,7 @@ class ObjectSets:
         starts, sizes = self.offsets[index], self.sizes[index]
         offsets = _offsets_from_sizes(sizes)
         rows = np.repeat(starts - offsets[:-1], sizes) + np.arange(offsets[-1])
-        return ObjectSets._trusted(self.data[rows], offsets)
+        return ObjectSets._trusted(self.data[rows], offsets, self.type_names)
 
     def __iter__(self):
         for i in range(len(self)):
@@ -393,10 +517,11 @@ class ObjectSets:
                 f"n_attributes={self.n_attributes})")
 
     def __getstate__(self):
-        return {"data": self.data, "offsets": self.offsets}
+        return {"data": self.data, "offsets": self.offsets, "type_names": self.type_names}
 
     def __setstate__(self, state):
         self.data, self.offsets = state["data"], state["offsets"]
+        self.type_names = state.get("type_names")
 
 
 def _is_ragged_batch(X):
@@ -453,7 +578,7 @@ def as_object_sets(X):
     copy is made when they are still float32 and intp).
     """
     if isinstance(X, ObjectSets) or _is_ragged_batch(X):
-        return ObjectSets(X.data, X.offsets)
+        return ObjectSets(X.data, X.offsets, getattr(X, "type_names", None))
     if isinstance(X, np.ndarray) and X.ndim == 3:
         raise ValueError(
             f"X is a 3D array of shape {X.shape}: its rows may be padding, which would be read "
@@ -513,6 +638,25 @@ class ObjectInputMixin:
     or transforming with the other kind is an error.
     """
 
+    def _named_as_fitted(self, sets):
+        """``sets`` with its type ids read through its type names into the ids of the names
+        seen at fit (a name not seen at fit gets an id no test reads)."""
+        fitted = getattr(self, "type_names_", None)
+        if sets.type_names is None:
+            return sets
+        if fitted is None:
+            raise ValueError(f"X names its types (type_names), but {type(self).__name__} was "
+                             f"fitted on unnamed type ids; pass type ids as at fit")
+        if _same_names(sets.type_names, fitted):
+            return sets
+        ids = {name: i for i, name in enumerate(fitted.tolist())}
+        table = np.array([ids.get(name, len(fitted)) for name in sets.type_names.tolist()],
+                         dtype=np.float32)
+        data = sets.data.copy()
+        if len(data):
+            data[:, -1] = table[data[:, -1].astype(np.intp)]
+        return ObjectSets._trusted(data, sets.offsets, fitted)
+
     def _validate_input(self, X, y=None, *, reset, requires_y=False, matrix=False):
         """Validate ``X`` (and ``y``) and return ``(sets, y)``; with ``matrix``, a feature
         matrix is returned as the validated float32 matrix instead of as object sets."""
@@ -565,6 +709,11 @@ class ObjectInputMixin:
         if reset:
             self._fitted_on_features = dense
             self.n_attributes_ = n_attributes
+            self.__dict__.pop("type_names_", None)
+            if not dense and sets.type_names is not None:
+                self.type_names_ = sets.type_names
+        elif not dense:
+            sets = self._named_as_fitted(sets)
         if requires_y:
             y = _check_targets(y)
             if len(y) != len(sets):
