@@ -28,6 +28,9 @@ _MAX_BANDS = 32
 _DEFAULT_BANDS = 8
 # counts, ids and loop bounds of the Cython core are 32-bit
 _INT32_MAX = 2**31 - 1
+# targets whose largest magnitude is from this on, or below its inverse, have squares (the
+# node variances) beyond float64
+_Y_MAX = 2.0**511
 # the sampling region drawn from the training objects reaches this share of their extent
 # beyond them, on every side
 _REGION_MARGIN = 0.05
@@ -103,6 +106,15 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             sets, y, sample_weight = sets[keep], y[keep], sample_weight[keep]
         if len(sets) > _INT32_MAX - 1:
             raise ValueError(f"at most {_INT32_MAX - 1} samples are supported, got {len(sets)}")
+        with np.errstate(over="ignore"):
+            total = sample_weight.sum()
+        if not np.isfinite(total):
+            raise ValueError("sample_weight sums to more than float64 holds (> 1.8e308); only "
+                             "the weights' ratios matter: scale them down")
+        # trees grow on weights and targets scaled by powers of two, exact in floating point:
+        # the same trees, and no overflow in the sums of weight * target^2 whatever their units
+        y_scale, w_scale = _power_of_two_scale(y), _power_of_two_scale(sample_weight)
+        y, sample_weight = y * y_scale, sample_weight * w_scale
         objects = _TrainingObjects(self, sets)
         split = self.min_samples_split
         params = _TreeParams(
@@ -115,6 +127,10 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             delayed(_grow_tree)(objects, y, sample_weight, params, int(seed), bootstrap)
             for seed in seeds
         )
+        for arrays in trees:     # back in the units of y and of the weights
+            arrays["value"] /= y_scale
+            arrays["impurity"] /= y_scale * y_scale
+            arrays["weighted_n_node_samples"] /= w_scale
         return [BoxTree.from_builder(self._node_arrays(arrays), self.types_, self.column_groups_,
                                      self.n_attributes_) for arrays in trees]
 
@@ -200,6 +216,13 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             self._pack(trees)
 
 
+def _power_of_two_scale(values):
+    """The power of two that brings the largest magnitude of ``values`` into [1, 2) (1 for
+    all zeros, and for unit weights: the builder has a faster path for those)."""
+    top = float(np.abs(values).max(initial=0.0))
+    return 1.0 if top == 0.0 else float(np.ldexp(1.0, 1 - int(np.frexp(top)[1])))
+
+
 @dataclass(frozen=True)
 class _TreeParams:
     """How one tree is grown (see ``boxtrees._builder.build_tree``)."""
@@ -235,6 +258,11 @@ class RegressionTargets(RegressorMixin):
         y = np.ascontiguousarray(y, dtype=np.float64)
         if not np.isfinite(y).all():
             raise ValueError("y contains NaN or infinite values")
+        top = np.abs(y).max(initial=0.0)
+        if top >= _Y_MAX or 0 < top < 1 / _Y_MAX:
+            raise ValueError(f"y has values of magnitude up to {top:.3g}: their squares, the "
+                             f"node variances (impurity), {'over' if top > 1 else 'under'}flow "
+                             f"float64; rescale y into [{1 / _Y_MAX:.3g}, {_Y_MAX:.3g})")
         self.n_outputs_ = 1 if y.ndim == 1 else y.shape[1]
         return y
 

@@ -115,7 +115,10 @@ class BoxTree:
         """Weighted variance reduction of the tests on each of ``types`` (sorted type ids),
         normalised to sum to 1 (all zeros for a single-leaf tree), shape (len(types),)."""
         inner = np.flatnonzero(self.children_left != TREE_LEAF)
-        w, imp = self.weighted_n_node_samples, self.impurity
+        # in units of the root's weight and of the largest impurity (they cancel out in the
+        # normalised result), so that weights and targets of any finite size stay finite
+        w = self.weighted_n_node_samples / self.weighted_n_node_samples[0]
+        imp = self.impurity / (self.impurity.max() or 1.0)
         left, right = self.children_left[inner], self.children_right[inner]
         decrease = w[inner] * imp[inner] - w[left] * imp[left] - w[right] * imp[right]
         position = np.searchsorted(types, self.object_type[inner])

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from boxtrees import BoxExtraTreesRegressor, BoxTree, GridCounts, ObjectSets
+from boxtrees import BoxExtraTreesRegressor, BoxTree, GridCounts, ObjectSets, make_box_regression
 from boxtrees._builder import MAX_GROUP_COLUMNS, build_tree
 from conftest import THESIS_FOREST
 from boxtrees._predictor import PackedForest, apply_leaves, predict_mean
@@ -267,3 +267,41 @@ def test_fit_on_a_feature_matrix_needs_memory_for_its_samples_not_a_copy_of_the_
     # kept sorted copies of every column, three times the matrix)
     assert peak < X.nbytes / 2, peak
     assert forest.score(X, y) > 0.9
+
+
+@pytest.mark.parametrize("weight", [1e-300, 3.0, 1e200, 1e300, 1e305])
+def test_weights_of_any_finite_size_grow_the_trees_of_unit_weights(weight):
+    X, y = make_box_regression(400, random_state=0)
+    reference = BoxExtraTreesRegressor(4, random_state=0).fit(X, y)
+    scaled = BoxExtraTreesRegressor(4, random_state=0).fit(X, y, sample_weight=np.full(400, weight))
+    for a, b in zip(reference, scaled):
+        np.testing.assert_array_equal(a.tree_.box, b.tree_.box)
+        np.testing.assert_array_equal(a.tree_.n_node_samples, b.tree_.n_node_samples)
+        np.testing.assert_allclose(b.tree_.weighted_n_node_samples,
+                                   a.tree_.weighted_n_node_samples * weight, rtol=1e-12)
+    np.testing.assert_allclose(scaled.predict(X), reference.predict(X), rtol=1e-12)
+    np.testing.assert_allclose(scaled.feature_importances_, reference.feature_importances_,
+                               rtol=1e-9)
+
+
+@pytest.mark.parametrize("scale", [2.0**-500, 1e-100, 7.0, 1e100, 1e150])
+def test_targets_of_any_representable_size_grow_the_same_trees(scale):
+    X, y = make_box_regression(400, random_state=0)
+    y = y / np.abs(y).max()
+    reference = BoxExtraTreesRegressor(4, random_state=0).fit(X, y)
+    scaled = BoxExtraTreesRegressor(4, random_state=0).fit(X, y * scale)
+    for a, b in zip(reference, scaled):
+        np.testing.assert_array_equal(a.tree_.box, b.tree_.box)
+    np.testing.assert_allclose(scaled.predict(X) / scale, reference.predict(X), rtol=1e-12)
+    np.testing.assert_allclose(scaled.feature_importances_, reference.feature_importances_,
+                               rtol=1e-9)
+
+
+def test_inputs_beyond_float64_are_named():
+    X, y = make_box_regression(100, random_state=0)
+    y = y / np.abs(y).max()
+    with pytest.raises(ValueError, match=r"sample_weight sums to more than float64 holds"):
+        BoxExtraTreesRegressor(2).fit(X, y, sample_weight=np.full(100, 1e308))
+    for scale, which in ((1e307, "overflow"), (1e-300, "underflow")):
+        with pytest.raises(ValueError, match=rf"y has values of magnitude .* {which} float64"):
+            BoxExtraTreesRegressor(2).fit(X, y * scale)
