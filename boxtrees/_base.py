@@ -2,6 +2,7 @@
 encoding of regression and classification targets."""
 import os
 import threading
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from math import ceil
@@ -28,8 +29,8 @@ _MAX_BANDS = 32
 _DEFAULT_BANDS = 8
 # counts, ids and loop bounds of the Cython core are 32-bit
 _INT32_MAX = 2**31 - 1
-# targets whose largest magnitude is from this on, or below its inverse, have squares (the
-# node variances) beyond float64
+# targets whose largest magnitude is from this on (below its inverse) have squares, the node
+# variances, that overflow (underflow) float64
 _Y_MAX = 2.0**511
 # the sampling region drawn from the training objects reaches this share of their extent
 # beyond them, on every side
@@ -259,10 +260,15 @@ class RegressionTargets(RegressorMixin):
         if not np.isfinite(y).all():
             raise ValueError("y contains NaN or infinite values")
         top = np.abs(y).max(initial=0.0)
-        if top >= _Y_MAX or 0 < top < 1 / _Y_MAX:
+        if top >= _Y_MAX:
             raise ValueError(f"y has values of magnitude up to {top:.3g}: their squares, the "
-                             f"node variances (impurity), {'over' if top > 1 else 'under'}flow "
-                             f"float64; rescale y into [{1 / _Y_MAX:.3g}, {_Y_MAX:.3g})")
+                             f"node variances (impurity), overflow float64; rescale y below "
+                             f"{_Y_MAX:.3g}")
+        if 0 < top < 1 / _Y_MAX:
+            warnings.warn(f"y has values of magnitude at most {top:.3g}: the trees grow on them "
+                          f"rescaled, but their squares, the node variances (impurity), "
+                          f"underflow float64 to 0, and so do feature_importances_; rescale y "
+                          f"above {1 / _Y_MAX:.3g} to read them", UserWarning, stacklevel=4)
         self.n_outputs_ = 1 if y.ndim == 1 else y.shape[1]
         return y
 
