@@ -114,8 +114,8 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
                              "the weights' ratios matter: scale them down")
         # trees grow on weights and targets scaled by powers of two, exact in floating point:
         # the same trees, and no overflow in the sums of weight * target^2 whatever their units
-        y_scale, w_scale = _power_of_two_scale(y), _power_of_two_scale(sample_weight)
-        y, sample_weight = y * y_scale, sample_weight * w_scale
+        y_exponent, w_exponent = _scale_exponent(y), _scale_exponent(sample_weight)
+        y, sample_weight = np.ldexp(y, y_exponent), np.ldexp(sample_weight, w_exponent)
         objects = _TrainingObjects(self, sets)
         split = self.min_samples_split
         params = _TreeParams(
@@ -129,9 +129,10 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             for seed in seeds
         )
         for arrays in trees:     # back in the units of y and of the weights
-            arrays["value"] /= y_scale
-            arrays["impurity"] /= y_scale * y_scale
-            arrays["weighted_n_node_samples"] /= w_scale
+            arrays["value"] = np.ldexp(arrays["value"], -y_exponent)
+            arrays["impurity"] = np.ldexp(arrays["impurity"], -2 * y_exponent)
+            arrays["weighted_n_node_samples"] = np.ldexp(arrays["weighted_n_node_samples"],
+                                                         -w_exponent)
         return [BoxTree.from_builder(self._node_arrays(arrays), self.types_, self.column_groups_,
                                      self.n_attributes_) for arrays in trees]
 
@@ -217,11 +218,12 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             self._pack(trees)
 
 
-def _power_of_two_scale(values):
-    """The power of two that brings the largest magnitude of ``values`` into [1, 2) (1 for
-    all zeros, and for unit weights: the builder has a faster path for those)."""
+def _scale_exponent(values):
+    """The exponent ``k`` such that ``values * 2**k`` has its largest magnitude in [1, 2) (0
+    for all zeros, and for unit weights: the builder has a faster path for those); applied
+    with ``np.ldexp``, which reaches the subnormals too."""
     top = float(np.abs(values).max(initial=0.0))
-    return 1.0 if top == 0.0 else float(np.ldexp(1.0, 1 - int(np.frexp(top)[1])))
+    return 0 if top == 0.0 else 1 - int(np.frexp(top)[1])
 
 
 @dataclass(frozen=True)

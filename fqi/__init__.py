@@ -3,7 +3,8 @@ plus the baselines of the thesis.
 
 - `FQI`: the agent (``learn``, ``predict``, ``save`` / ``load``, a CSV log), on ``Box``
   observations (a feature matrix: any scikit-learn regressor) or object sets
-  (``Sequence(Box(shape=(3,)))``: `boxtrees.BoxExtraTreesRegressor`);
+  (``Sequence(Box(shape=(d + 1,)))``, rows ``[f_1, ..., f_d, type]``:
+  `boxtrees.BoxExtraTreesRegressor`);
 - `evaluate`: one greedy episode per fixed reset seed, total and mean return, for any policy
   with a ``predict`` method (`RandomPolicy`, DQN, `FQI`);
 - baselines: `make_box_forest` (thesis parameters; ``test_type="classic"``),

@@ -42,7 +42,7 @@ class FQI:
     `regressor` fitted at every iteration; the agent only calls ``fit(X, y)`` and
     ``predict(X)``. ``X`` follows the env's observation space: for a ``Box``, a 2D float
     matrix with one flattened observation per row, so any scikit-learn regressor plugs in;
-    for ``Sequence(Box(shape=(3,)))`` (sets of ``[x, y, type]`` objects), one
+    for ``Sequence(Box(shape=(d + 1,)))`` (sets of ``[f_1, ..., f_d, type]`` objects), one
     `boxtrees.ObjectSets` (``data`` + ``offsets``) per batch, which
     `boxtrees.BoxExtraTreesRegressor` or a pipeline starting with `boxtrees.GridCounts` take.
 
@@ -72,7 +72,7 @@ class FQI:
         from the observation space and uses every core.
     env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable
         The environment; its action space must be ``Discrete`` (numbered from 0) and its
-        observation space a ``Box`` or ``Sequence(Box(shape=(3,)))``. A registered id is made
+        observation space a ``Box`` or ``Sequence(Box(shape=(d + 1,)))``. A registered id is made
         with ``gymnasium.make_vec(id, num_envs=n_envs)``, which uses the id's
         ``vector_entry_point`` (a batched engine) when it has one and a ``SyncVectorEnv``
         otherwise; an env made by ``gymnasium.make`` is rebuilt the same way from its spec;
@@ -537,11 +537,12 @@ class FQI:
         ----------
         observation : array-like or batch
             For a ``Box`` space: one observation of its shape, or a batch
-            ``(batch, *shape)``. For object sets: one ``(n, 3)`` array of rows
-            ``[x, y, type]``; a batch: anything with ``data`` and ``offsets`` (a
-            `boxtrees.ObjectSets`, a batched engine's observations), a list of ``(n_i, 3)``
-            arrays or a ``(batch, n, 3)`` array; or padded rows ``[x, y, type, valid]``
-            (``envs.PaddedObjects``): ``(max_objects, 4)`` or ``(batch, max_objects, 4)``.
+            ``(batch, *shape)``. For object sets: one ``(n, d + 1)`` array of rows
+            ``[f_1, ..., f_d, type]``; a batch: anything with ``data`` and ``offsets`` (a
+            `boxtrees.ObjectSets`, a batched engine's observations), a list of ``(n_i, d +
+            1)`` arrays or a ``(batch, n, d + 1)`` array; or padded rows ``[f_1, ..., f_d,
+            type, valid]`` (``envs.PaddedObjects``): ``(max_objects, d + 2)`` or ``(batch,
+            max_objects, d + 2)``.
         state, episode_start
             Unused (the policy is reactive); accepted for stable-baselines3.
         deterministic : bool, default=True

@@ -45,14 +45,15 @@ def make_box_forest(env=None, *, test_type="fixed", test_width=1.0, n_estimators
     Parameters
     ----------
     env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable, default=None
-        For object-set observations ``Sequence(Box(shape=(3,)))``, the x and y bounds of
-        its rows are the view square the tests are drawn in. None, or a ``Box`` env: the
+        For object-set observations ``Sequence(Box(shape=(d + 1,)))``, the bounds of its
+        rows' attributes are the region the tests are drawn in (the view square for
+        ``[x, y, type]``). None, or a ``Box`` env: the
         forest draws them in the bounding box of its training data.
     test_type, test_width, n_estimators, n_tests, min_samples_split, n_jobs, random_state
         As in `boxtrees.BoxExtraTreesRegressor` (``n_jobs=-1``: every core), and checked
         here against its parameter constraints rather than at the first fit.
-    view_bounds : tuple of 4 floats, default=None
-        ``(xmin, xmax, ymin, ymax)``, instead of the env's.
+    view_bounds : tuple of 2 * d floats, default=None
+        ``(xmin, xmax, ymin, ymax)`` (``(low, high)`` per attribute), instead of the env's.
 
     Returns
     -------

@@ -4,8 +4,9 @@ The observation space of the env decides:
 
 - ``Box``: one flattened float row per observation, a 2D matrix any scikit-learn regressor
   takes;
-- ``Sequence(Box(shape=(3,)))``: object sets (rows ``[x, y, type]``), one
-  `boxtrees.ObjectSets` (``data`` + ``offsets``) per batch;
+- ``Sequence(Box(shape=(d + 1,)))``, ``d >= 1``: object sets (rows ``[f_1, ..., f_d, type]``,
+  ``[x, y, type]`` for the thesis's game), one `boxtrees.ObjectSets` (``data`` + ``offsets``)
+  per batch;
 - anything else: a TypeError that names the space and what to wrap it in.
 """
 import numpy as np
@@ -20,15 +21,11 @@ def _observation_format(space):
     """The `_FeatureRows` or `_ObjectRows` reading observations of `space`."""
     if isinstance(space, spaces.Box):
         return _FeatureRows(space)
-    if (isinstance(space, spaces.Sequence) and isinstance(space.feature_space, spaces.Box)
-            and space.feature_space.shape == (3,)):
-        return _ObjectRows(space)
     if isinstance(space, spaces.Sequence) and isinstance(space.feature_space, spaces.Box):
-        raise TypeError(f"object-set observations must have rows of 3 numbers [x, y, type] "
-                        f"(boxtrees.ObjectSets); got {space}: wrap the env in a "
-                        f"gymnasium.ObservationWrapper that keeps those 3 columns")
-    raise TypeError(f"FQI takes Box observations (feature vectors) or Sequence(Box(shape=(3,)))"
-                    f" (object sets of [x, y, type] rows); got {space}: wrap the env in "
+        _row_box(space)     # rows of at least 2 numbers [f_1, ..., f_d, type]
+        return _ObjectRows(space)
+    raise TypeError(f"FQI takes Box observations (feature vectors) or Sequence(Box(shape=(d + "
+                    f"1,))) (object sets of [f_1, ..., f_d, type] rows); got {space}: wrap the env in "
                     f"gymnasium.wrappers.FlattenObservation (for Dict, Tuple, Discrete, "
                     f"MultiDiscrete and MultiBinary spaces) or in a gymnasium.ObservationWrapper "
                     f"returning a Box")
@@ -81,38 +78,47 @@ class _FeatureRows:
 
 
 class _ObjectRows:
-    """``Sequence(Box(shape=(3,)))`` observations as `boxtrees.ObjectSets`.
+    """``Sequence(Box(shape=(d + 1,)))`` observations as `boxtrees.ObjectSets`.
 
     A batch from a vector env is anything with ``data`` and ``offsets`` (a batched engine's
     ragged batch) or one observation per env (gymnasium's batch of a ``Sequence`` space). As
-    `predict` input, padded rows ``[x, y, type, valid]`` (``envs.PaddedObjects``) are
-    accepted too.
+    `predict` input, padded rows ``[f_1, ..., f_d, type, valid]`` (``envs.PaddedObjects``)
+    are accepted too.
     """
 
-    what = "boxtrees.ObjectSets (variable-size sets of [x, y, type] rows)"
+    what = "boxtrees.ObjectSets (variable-size sets of [f_1, ..., f_d, type] rows)"
 
     def __init__(self, space):
         self.space = space
+        self.width = _row_box(space).shape[0]     # d + 1
+
+    def _rows(self, observation):
+        """One observation (stacked, or a tuple of rows) as an ``(n, d + 1)`` array."""
+        rows = np.asarray(observation, dtype=np.float32)
+        if rows.size and (rows.ndim != 2 or rows.shape[1] != self.width):
+            raise ValueError(f"the env returned an observation of shape {rows.shape}, but the "
+                             f"rows of its observation space {self.space} have {self.width} "
+                             f"numbers")
+        return rows.reshape(-1, self.width)
 
     def batch(self, obs):
         """A vector env's batched observations as an ObjectSets."""
         if hasattr(obs, "data") and hasattr(obs, "offsets"):
             return obs if isinstance(obs, ObjectSets) else ObjectSets(obs.data, obs.offsets)
-        return ObjectSets.from_sequence([_rows(o) for o in obs])
+        return ObjectSets.from_sequence([self._rows(o) for o in obs])
 
-    @staticmethod
-    def replaced(batch, mask, observations):
+    def replaced(self, batch, mask, observations):
         """`batch` with the sets of `mask` replaced by `observations`, one each."""
         new = iter(observations)
-        return ObjectSets.from_sequence([_rows(next(new)) if replace else batch[i]
+        return ObjectSets.from_sequence([self._rows(next(new)) if replace else batch[i]
                                          for i, replace in enumerate(mask)])
 
     concatenate = staticmethod(ObjectSets.concatenate)
 
     def as_input(self, observation):
-        """One ``(n, 3)`` array, or a batch (``data`` + ``offsets``, a list of ``(n_i, 3)``
-        arrays, a ``(batch, n, 3)`` array), or padded rows ``(max_objects, 4)`` /
-        ``(batch, max_objects, 4)``; returns ``(ObjectSets, whether it was one)``."""
+        """One ``(n, d + 1)`` array, or a batch (``data`` + ``offsets``, a list of ``(n_i, d +
+        1)`` arrays, a ``(batch, n, d + 1)`` array), or padded rows ``(max_objects, d + 2)``
+        / ``(batch, max_objects, d + 2)``; returns ``(ObjectSets, whether it was one)``."""
         if hasattr(observation, "data") and hasattr(observation, "offsets"):
             return self.batch(observation), False
         if isinstance(observation, (list, tuple)):
@@ -120,59 +126,62 @@ class _ObjectRows:
         array = np.asarray(observation)
         if array.dtype.kind not in "biuf":
             raise TypeError(f"observation must hold numbers, got dtype {array.dtype}")
-        if array.ndim in (2, 3) and array.shape[-1] in (3, 4):
+        width = self.width
+        if array.ndim in (2, 3) and array.shape[-1] in (width, width + 1):
             single = array.ndim == 2
             sets = array[None] if single else array
-            if array.shape[-1] == 4:  # padded: keep the valid rows
-                sets = [rows[rows[:, 3] > 0.5, :3] for rows in sets]
+            if array.shape[-1] == width + 1:  # padded: keep the valid rows
+                return ObjectSets.from_padded(sets[..., :width], sets[..., width] > 0.5), single
             return ObjectSets.from_sequence(list(sets)), single
-        raise ValueError(f"observation must be an (n, 3) array of objects [x, y, type], a "
-                         f"batch of them, or padded (max_objects, 4) / (batch, max_objects, 4) "
-                         f"rows [x, y, type, valid] (envs.PaddedObjects); got shape "
-                         f"{array.shape}")
-
-
-def _rows(observation):
-    """One observation of a ``Sequence(Box(shape=(3,)))`` space (stacked or a tuple of
-    rows) as an ``(n, 3)`` array."""
-    return np.asarray(observation, dtype=np.float32).reshape(-1, 3)
+        raise ValueError(f"observation must be an (n, {width}) array of objects [f_1, ..., f_d, "
+                         f"type], a batch of them, or padded (max_objects, {width + 1}) / (batch, "
+                         f"max_objects, {width + 1}) rows [f_1, ..., f_d, type, valid] "
+                         f"(envs.PaddedObjects); got shape {array.shape}")
 
 
 def _row_box(space):
-    """The ``Box`` of the rows of object-set observations ``Sequence(Box(shape=(3,)))``."""
+    """The ``Box`` of the rows of object-set observations ``Sequence(Box(shape=(d + 1,)))``,
+    ``d >= 1``."""
     if not (isinstance(space, spaces.Sequence) and isinstance(space.feature_space, spaces.Box)
-            and space.feature_space.shape == (3,)):
-        raise TypeError(f"view bounds and object types are read from object-set "
-                        f"observations, Sequence(Box(shape=(3,))); got {space}")
+            and len(space.feature_space.shape) == 1 and space.feature_space.shape[0] >= 2):
+        raise TypeError(f"object-set observations have rows of at least 2 numbers [f_1, ..., "
+                        f"f_d, type], Sequence(Box(shape=(d + 1,))); got {space}: wrap the env "
+                        f"in a gymnasium.ObservationWrapper that returns such rows")
     return space.feature_space
 
 
 def _view_bounds(space):
-    """The view square ``(xmin, xmax, ymin, ymax)`` of object-set observations: the x and y
-    bounds of their rows."""
+    """The sampling region of object-set observations: ``(low, high)`` of each attribute of
+    their rows, ``(xmin, xmax, ymin, ymax)`` for ``[x, y, type]``."""
     box = _row_box(space)
-    view_bounds = tuple(float(v) for v in (box.low[0], box.high[0], box.low[1], box.high[1]))
+    d = box.shape[0] - 1
+    view_bounds = tuple(float(v) for c in range(d) for v in (box.low[c], box.high[c]))
     if not np.isfinite(view_bounds).all():
-        raise ValueError(f"the object rows of {space} have unbounded x or y; give "
-                         f"view_bounds=(xmin, xmax, ymin, ymax)")
+        raise ValueError(f"the object rows of {space} have unbounded attributes; give "
+                         f"view_bounds=(low_1, high_1, ..., low_d, high_d)")
     return view_bounds
 
 
 def _object_bounds(space, view_bounds=None, n_types=None):
-    """The view square and number of types of object-set observations, read from the bounds
+    """The grid's extent (over the rows' first two attributes, the first alone for rows of
+    one attribute) and the number of types of object-set observations, read from the bounds
     of their rows' ``Box`` where not given.
 
     Returns
     -------
-    view_bounds : tuple of 4 floats ``(xmin, xmax, ymin, ymax)``
+    view_bounds : tuple of 4 floats ``(xmin, xmax, ymin, ymax)`` (2 for one attribute)
     n_types : int
     """
-    high = _row_box(space).high
+    box = _row_box(space)
     if view_bounds is None:
-        view_bounds = _view_bounds(space)
+        columns = range(min(box.shape[0] - 1, 2))
+        view_bounds = tuple(float(v) for c in columns for v in (box.low[c], box.high[c]))
+        if not np.isfinite(view_bounds).all():
+            raise ValueError(f"the object rows of {space} have unbounded x or y; give "
+                             f"view_bounds=(xmin, xmax, ymin, ymax)")
     if n_types is None:
-        if not np.isfinite(high[2]):
+        if not np.isfinite(box.high[-1]):
             raise ValueError(f"the object rows of {space} have an unbounded type; give "
                              f"n_types")
-        n_types = int(high[2]) + 1
+        n_types = int(box.high[-1]) + 1
     return view_bounds, n_types

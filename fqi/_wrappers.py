@@ -20,8 +20,8 @@ class GridObservation(gym.ObservationWrapper):
     Parameters
     ----------
     env : gymnasium.Env
-        An env (wrappers allowed) observing object sets, ``Sequence(Box(shape=(3,)))``
-        rows ``[x, y, type]``.
+        An env (wrappers allowed) observing object sets, ``Sequence(Box(shape=(d + 1,)))``
+        rows ``[f_1, ..., f_d, type]``; the grid lies over the first two attributes.
     n_bins : int, default=10
         Cells along each axis.
     view_bounds : tuple of 4 floats, default=None
@@ -56,8 +56,9 @@ class GridObservation(gym.ObservationWrapper):
     def __init__(self, env, n_bins=10, view_bounds=None, n_types=None):
         super().__init__(env)
         view_bounds, n_types = _object_bounds(env.observation_space, view_bounds, n_types)
+        width = env.observation_space.feature_space.shape[0]
         self.grid = GridCounts(n_bins, view_bounds=view_bounds,
-                               n_types=n_types).fit([np.empty((0, 3))])
+                               n_types=n_types).fit([np.empty((0, width))])
         n_features = len(self.grid.get_feature_names_out())
         self.observation_space = spaces.Box(0.0, np.inf, shape=(n_features,), dtype=np.float32)
 

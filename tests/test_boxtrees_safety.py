@@ -309,3 +309,14 @@ def test_inputs_beyond_float64_are_named():
     with pytest.warns(UserWarning, match=r"underflow float64 to 0, and so do feature_importances_"):
         tiny = BoxExtraTreesRegressor(2, random_state=0).fit(X, y * 1e-300)
     np.testing.assert_allclose(tiny.predict(X) / 1e-300, reference.predict(X), rtol=1e-12)
+
+
+def test_subnormal_targets_grow_their_trees():
+    X, y = make_box_regression(100, random_state=0)
+    y = y / np.abs(y).max()
+    reference = BoxExtraTreesRegressor(2, random_state=0).fit(X, y)
+    with pytest.warns(UserWarning, match="underflow"):
+        tiny = BoxExtraTreesRegressor(2, random_state=0).fit(X, y * 2.0**-1040)
+    assert np.isfinite(tiny.predict(X)).all()
+    for a, b in zip(reference, tiny):
+        np.testing.assert_array_equal(a.tree_.box, b.tree_.box)

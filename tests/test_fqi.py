@@ -310,7 +310,7 @@ def test_regressor_without_fit_predict(regressor, match):
 def test_env_needs_discrete_actions_and_grids_need_object_sets():
     with pytest.raises(TypeError, match="Discrete action space"):
         FQI(small_forest(), gym.make("Pendulum-v1"))
-    with pytest.raises(TypeError, match=r"object-set observations, Sequence\(Box"):
+    with pytest.raises(TypeError, match=r"object-set observations have rows .* Sequence\(Box"):
         GridObservation(gym.make("CartPole-v1"))
     with pytest.raises(TypeError, match="env must be"):
         FQI(small_forest(), 42)

@@ -18,7 +18,7 @@ from sklearn.linear_model import Ridge
 
 import fqi
 from boxtrees import BoxExtraTreesRegressor, ObjectSets
-from fqi import FQI, RandomPolicy, evaluate, make_box_forest, make_grid_ridge
+from fqi import FQI, GridObservation, RandomPolicy, evaluate, make_box_forest, make_grid_ridge
 from fqi._collect import _Collector
 from fqi._observations import _observation_format
 
@@ -176,6 +176,40 @@ def test_a_forest_needs_only_the_view_square_a_grid_also_the_types():
     with pytest.raises(ValueError, match="unbounded type; give n_types"):
         make_grid_ridge(AnyTypes)
     assert make_grid_ridge(AnyTypes, n_types=3)[0].n_types == 3
+
+
+class MovingCoins(Coins):
+    """Coins seen as rows ``[x, y, vx, type]``: every object also has a velocity, here a
+    distractor the forest has to do without."""
+
+    def __init__(self):
+        super().__init__()
+        row = spaces.Box(np.array([-5, -5, -1, 0]), np.array([5, 5, 1, 1]), dtype=np.float32)
+        self.observation_space = spaces.Sequence(row, stack=True)
+
+    def _obs(self):
+        velocity = self.np_random.uniform(-1, 1, len(self.objects))
+        rows = np.column_stack([self.objects[:, :2], velocity, self.objects[:, 2]])
+        return rows.astype(np.float32)
+
+
+def test_objects_of_more_attributes_learn_end_to_end():
+    forest = make_box_forest(MovingCoins(), n_estimators=10, n_tests=50, min_samples_split=5,
+                             n_jobs=1, random_state=0)
+    assert forest.view_bounds == (-5.0, 5.0, -5.0, 5.0, -1.0, 1.0)
+    agent = FQI(forest, MovingCoins, gamma=0.8, samples_per_iteration=2000, n_envs=20,
+                eval_episodes=20, seed=0).learn(4)
+    random_score = evaluate(RandomPolicy(MovingCoins, seed=0), MovingCoins, n_episodes=20).mean
+    assert agent.history[-1]["mean_return"] > random_score + 0.5, (
+        random_score, [r["mean_return"] for r in agent.history])
+    obs, _ = MovingCoins().reset(seed=3)
+    padded = np.zeros((8, 5), dtype=np.float32)
+    padded[:len(obs), :4], padded[:len(obs), 4] = obs, 1
+    assert agent.predict(padded)[0] == agent.predict(obs)[0]
+    # the grid lies over the first two attributes
+    grid_env = GridObservation(MovingCoins(), n_bins=5)
+    assert grid_env.reset(seed=0)[0].shape == (5 * 5 * 2,)
+    assert make_grid_ridge(MovingCoins)[0].view_bounds == (-5.0, 5.0, -5.0, 5.0)
 
 
 # ---------------------------------------------------------------- vector envs and autoreset
@@ -507,7 +541,8 @@ class NumberedFromOne(Countdown):
 @pytest.mark.parametrize("env, error, match", [
     ("Pendulum-v1", TypeError, r"needs a Discrete action space .*got Box\(-2.0, 2.0"),
     (DictObservation, TypeError, r"got Dict\('a'.*FlattenObservation"),
-    (WideRows, TypeError, r"rows of 3 numbers .*got Sequence\(Box\(-1.0, 1.0, \(5,\)"),
+    (WideRows, ValueError, r"observation of shape \(\d+, 3\), but the rows of its observation "
+                           r"space Sequence\(Box\(-1.0, 1.0, \(5,\).* have 5 numbers"),
     ("FrozenLake-v1", TypeError, r"got Discrete\(16\): wrap the env in .*FlattenObservation"),
     (Broken, RuntimeError, r"\.step raised RuntimeError: the simulator lost its connection "
                            r"\(FQI tries the env once"),
