@@ -11,11 +11,11 @@ from numbers import Integral
 import numpy as np
 from scipy.sparse import issparse
 
+from ._rows import MAX_TYPE as _MAX_TYPE
 from ._rows import RowProblem, scan_offsets, scan_rows
 
 __all__ = ["ObjectSets"]
 
-_MAX_TYPE = 2**24  # float32 holds every integer type id below this exactly
 _FLOAT32_MAX = float(np.finfo(np.float32).max)
 _DEFAULT_WIDTH = 3  # the columns of a batch with no object at all: [x, y, type]
 

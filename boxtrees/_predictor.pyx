@@ -20,7 +20,7 @@ from libc.math cimport INFINITY
 from libc.stdint cimport int16_t
 
 from ._utils cimport (
-    BAD_OFFSETS, ROW_OK, ROW_TYPE_TOO_LARGE, TREE_LEAF, coord_t, float64_t, int32, intp_t,
+    BAD_OFFSETS, MAX_TYPE, ROW_OK, ROW_TYPE_TOO_LARGE, TREE_LEAF, coord_t, float64_t, int32, intp_t,
     row_problem,
 )
 
@@ -49,8 +49,6 @@ cnp.import_array()
 cdef enum:
     BLOCK = 64
 
-# type ids from this one on are never a tree's (boxtrees._objects rejects them at fit)
-cdef double MAX_TYPE = 2.0 ** 24
 
 cdef boxtrees_node _layout
 cdef boxtrees_extra _extra_layout

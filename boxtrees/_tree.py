@@ -2,11 +2,9 @@
 import numpy as np
 
 from ._builder import NODE_FIELDS
+from ._rows import TREE_LEAF, TREE_UNDEFINED
 
 __all__ = ["BoxTree", "TREE_LEAF", "TREE_UNDEFINED"]
-
-TREE_LEAF = -1
-TREE_UNDEFINED = -2
 # a tree's node arrays: the builder's, with the box over every attribute in place of the
 # builder's (column group, box over the group's columns)
 _FIELDS = tuple(name for name in NODE_FIELDS if name != "group")

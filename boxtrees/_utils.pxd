@@ -12,6 +12,7 @@ ctypedef uint64_t uint64
 cdef enum:
     TREE_LEAF = -1            # children_* of a leaf
     TREE_UNDEFINED = -2       # object_type / threshold of a leaf
+    MAX_TYPE = 16777216       # 2**24: float32 holds every integer type id below it exactly
 
 cdef enum RowProblem:
     # what is wrong with an object row [f_1, ..., f_d, type] (or with a batch's offsets),
