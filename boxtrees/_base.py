@@ -17,6 +17,7 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import _check_sample_weight, check_is_fitted
 
 from ._builder import MAX_GROUP_COLUMNS, TEST_KINDS, build_tree
+from ._index import index_segments
 from ._objects import _FLOAT32_MAX, ObjectInputMixin, check_view_bounds, row_error
 from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
@@ -435,28 +436,11 @@ class _TrainingObjects:
         # every group has n_bands bands; the last ones of a group with fewer are empty
         self.band_edges = np.array([np.pad(e, (0, n_bands + 1 - len(e)), constant_values=np.inf)
                                     for e in edges])
-        sample = sets.sample_index().astype(np.int32)
-        xs, ys, sample_of, segments, object_of = [], [], [], [], []
-        for g, columns in enumerate(groups):
-            x = data[:, columns[0]]
-            y = data[:, columns[1]] if len(columns) > 1 else np.zeros_like(x)
-            bands = np.searchsorted(edges[g][1:-1], y, side="right")
-            segment = (g * n_types + position) * n_bands + bands
-            order = np.lexsort((x, segment))
-            xs.append(x[order])
-            ys.append(y[order])
-            sample_of.append(sample[order])
-            segments.append(segment[order])
-            object_of.append(order)
-        self.x = np.ascontiguousarray(np.concatenate(xs))
-        self.y = np.ascontiguousarray(np.concatenate(ys))
-        self.sample_of = np.concatenate(sample_of)
+        self.x, self.y, self.sample_of, object_of, self.segment_ptr = index_segments(
+            data, sets.sample_index().astype(np.int32), position, groups, n_types, edges)
         if (self.group_sizes > 2).any():   # their further columns are read in the rows
             self.attributes = np.ascontiguousarray(data[:, :estimator.n_attributes_])
-            self.object_of = np.concatenate(object_of).astype(np.int32)
-        self.segment_ptr = np.searchsorted(
-            np.concatenate(segments), np.arange(len(groups) * n_types * n_bands + 1)
-        ).astype(np.intp)
+            self.object_of = object_of
 
 
 def _with_margin(low, high):

@@ -21,6 +21,7 @@ _builder = importlib.import_module("boxtrees._builder")
 _predictor = importlib.import_module("boxtrees._predictor")
 _rows = importlib.import_module("boxtrees._rows")
 _tree = importlib.import_module("boxtrees._tree")
+_index = importlib.import_module("boxtrees._index")
 _NODE_ARRAYS = _tree._FIELDS
 
 
@@ -44,21 +45,9 @@ def training_arrays(rng, n, per_sample, n_types, n_bands, spread, groups):
     sample = np.repeat(np.arange(n), sizes).astype(np.int32)
     edges = np.concatenate([[-np.inf], np.linspace(-1, 1, n_bands + 1)[1:-1], [np.inf]])
     one_band = np.concatenate([[-np.inf], np.full(n_bands, np.inf)])
-    band_edges, xs, ys, samples, segments, order_of = [], [], [], [], [], []
-    for g, columns in enumerate(groups):
-        x = data[:, columns[0]]
-        y = data[:, columns[1]] if len(columns) > 1 else np.zeros_like(x)
-        band_edges.append(edges if len(columns) > 1 else one_band)
-        bands = np.searchsorted(band_edges[-1][1:-1], y, side="right")
-        segment = (g * n_types + data[:, d].astype(np.intp)) * n_bands + bands
-        order = np.lexsort((x, segment))
-        xs.append(x[order])
-        ys.append(y[order])
-        samples.append(sample[order])
-        segments.append(segment[order])
-        order_of.append(order)
-    segment_ptr = np.searchsorted(np.concatenate(segments),
-                                  np.arange(len(groups) * n_types * n_bands + 1)).astype(np.intp)
+    band_edges = [edges if len(columns) > 1 else one_band for columns in groups]
+    x, y, sample_of, object_of, segment_ptr = _index.index_segments(
+        data, sample, data[:, d].astype(np.intp), groups, n_types, band_edges)
     width = _builder.MAX_GROUP_COLUMNS
     bounds = np.tile(np.array([-1, 1] * width, dtype=np.float32), (len(groups) * n_types, 1))
     extra = np.full((len(groups), width - 2), -1)
@@ -66,14 +55,12 @@ def training_arrays(rng, n, per_sample, n_types, n_bands, spread, groups):
         if len(columns) == 1:
             bounds[g * n_types:(g + 1) * n_types, 2:4] = [-np.inf, np.inf]
         extra[g, :max(len(columns) - 2, 0)] = columns[2:]
-    objects = SimpleNamespace(x=np.concatenate(xs), y=np.concatenate(ys),
-                              sample_of=np.concatenate(samples), segment_ptr=segment_ptr,
+    objects = SimpleNamespace(x=x, y=y, sample_of=sample_of, segment_ptr=segment_ptr,
                               band_edges=np.array(band_edges), bounds=bounds,
                               half_widths=np.full((len(bounds), width), 0.7),
                               group_sizes=[len(columns) for columns in groups],
                               attributes=np.ascontiguousarray(data[:, :d]),
-                              object_of=np.concatenate(order_of).astype(np.int32),
-                              extra_columns=extra)
+                              object_of=object_of, extra_columns=extra)
     return data, offsets, objects
 
 
