@@ -152,20 +152,8 @@ class BoxExtraTreeRegressor(RegressionTargets, _SingleTree):
     ----------
     tree_ : BoxTree
         The fitted tree, as flat node arrays.
-    types_ : ndarray of int
-        Sorted type ids seen at fit (the column indices for a feature matrix).
-    n_types_ : int
-        ``len(types_)``.
-    n_attributes_ : int
-        Number of attributes ``d`` of the objects seen at fit (1 for a feature matrix).
-    column_groups_ : tuple of tuple of int
-        The column groups the tests draw from.
-    bounds_ : ndarray of shape (n_types_, 2 * n_attributes_)
-        Sampling region per type of ``types_``, ``(low, high)`` per attribute.
-    n_features_in_ : int
-        Number of columns, when fitted on a feature matrix.
-    feature_names_in_ : ndarray of str
-        Column names, when fitted on a data frame with string column names.
+    types_, n_types_, type_names_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_
+        As in `BoxExtraTreesRegressor`.
 
     Examples
     --------
@@ -200,8 +188,8 @@ class BoxExtraTreeClassifier(ClassificationTargets, _SingleTree):
         The class labels.
     n_classes_ : int or list of int
     n_outputs_ : int
-    types_, n_types_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_
-        As in `BoxExtraTreeRegressor`.
+    types_, n_types_, type_names_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_
+        As in `BoxExtraTreesRegressor`.
 
     Examples
     --------

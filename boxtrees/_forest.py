@@ -13,11 +13,6 @@ from ._extra_tree import BoxExtraTreeClassifier, BoxExtraTreeRegressor
 
 __all__ = ["BoxExtraTreesClassifier", "BoxExtraTreesRegressor"]
 
-# fitted attributes a forest hands to each of its trees
-_SHARED_FITTED = ("types_", "n_types_", "n_attributes_", "column_groups_", "bounds_",
-                  "_fitted_on_features", "n_features_in_", "feature_names_in_", "n_outputs_",
-                  "classes_", "n_classes_")
-
 
 class _Forest(BaseBoxTrees):
     """Fitting and walking a forest of trees of class ``_tree_class``."""
@@ -92,7 +87,11 @@ class _Forest(BaseBoxTrees):
                                 bootstrap=self.bootstrap)
         params = {name: getattr(self, name) for name in self._tree_class._get_param_names()
                   if name != "random_state"}
-        fitted = {name: value for name, value in self.__dict__.items() if name in _SHARED_FITTED}
+        # what fitting taught the forest about the data, its trees know too: every fitted
+        # attribute (scikit-learn's trailing underscore) but the trees themselves
+        fitted = {name: value for name, value in self.__dict__.items()
+                  if (name.endswith("_") and not name.startswith("_") and name != "estimators_")
+                  or name == "_fitted_on_features"}
         self.estimators_ = []
         for tree, seed in zip(trees, seeds):
             estimator = self._tree_class(**params, random_state=int(seed))
@@ -257,6 +256,10 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         drawn on these types only; other ids at predict time match no test.
     n_types_ : int
         ``len(types_)``.
+    type_names_ : ndarray
+        The label of each type id (``type_names_[t]`` names id ``t``), when fitted on
+        object sets whose types are named (`ObjectSets.from_frame`); a batch whose types are
+        named is read by name at predict.
     n_attributes_ : int
         Number of attributes ``d`` of the objects seen at fit (1 for a feature matrix).
     column_groups_ : tuple of tuple of int
@@ -326,7 +329,7 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
         The class labels, in the column order of ``predict_proba``.
     n_classes_ : int or list of int
     n_outputs_ : int
-    types_, n_types_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_
+    types_, n_types_, type_names_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_
         As in `BoxExtraTreesRegressor`.
 
     Examples

@@ -76,6 +76,8 @@ def test_the_estimators_learn_from_frames_and_read_new_frames_by_type_name():
     without = ObjectSets.from_frame(test[test.label != "bike"], samples=1000 + np.arange(200),
                                     **read)
     np.testing.assert_array_equal(forest.predict(X_renamed), forest.predict(without))
+    # a tree of the forest reads names as the forest does
+    np.testing.assert_array_equal(forest[0].predict(X_renamed), forest[0].predict(without))
     again = pickle.loads(pickle.dumps(forest))
     np.testing.assert_array_equal(again.predict(X_renamed), forest.predict(X_renamed))
     # named types at predict need names at fit
