@@ -18,7 +18,7 @@ from sklearn.utils.validation import _check_sample_weight, check_is_fitted
 
 from ._builder import MAX_GROUP_COLUMNS, TEST_KINDS, build_tree
 from ._index import index_segments
-from ._objects import _FLOAT32_MAX, ObjectInputMixin, check_view_bounds, row_error
+from ._objects import _FLOAT32_MAX, ObjectInputMixin, check_view_bounds, fitted_region, row_error
 from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
 from ._tree import BoxTree
@@ -369,8 +369,9 @@ class ClassificationTargets(ClassifierMixin):
 class _TrainingObjects:
     """The training objects indexed for the tree builder.
 
-    A test's box spans the columns of one column group: its x column, and its y column if
-    it has two. Every group indexes all the objects of sets, in segments, one per (group,
+    A test's box spans the columns of one column group: its x column, its y column if it has
+    two, and further columns read in the objects' rows (``attributes``, ``object_of``) if it
+    has more. Every group indexes all the objects of sets, in segments, one per (group,
     type position, y band), sorted by x in each; ``sample_of`` is the sample of each object.
     A feature matrix is passed as it is, as ``columns`` (the builder reads it in place; its
     values are one attribute, one group). Sets the estimator's ``types_``, ``n_types_``,
@@ -382,14 +383,16 @@ class _TrainingObjects:
         d = estimator.n_attributes_
         if features:          # ``sets`` is the feature matrix: each column is one attribute
             estimator.types_ = np.arange(estimator.n_features_in_)
-            low, high = sets.min(axis=0), sets.max(axis=0)
+            spanned = fitted_region(sets, range(sets.shape[1]))
         else:
             data = sets.data
             estimator.types_, position = np.unique(data[:, d].astype(np.intp), return_inverse=True)
             if not len(estimator.types_):
                 estimator.types_ = np.zeros(1, dtype=np.intp)
-            low, high = (data[:, :d].min(axis=0), data[:, :d].max(axis=0)) if len(data) else \
-                (np.zeros(d), np.ones(d))
+            spanned = fitted_region(data, range(d))
+            if spanned is None:          # no object at all: any region will do
+                spanned = np.tile([0.0, 1.0], (d, 1))
+        low, high = spanned[:, 0], spanned[:, 1]
         estimator.n_types_ = n_types = len(estimator.types_)
         estimator.column_groups_ = groups = _column_groups(estimator.column_groups, d)
         if estimator.view_bounds is not None:

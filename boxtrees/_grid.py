@@ -6,7 +6,7 @@ from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 
-from ._objects import _MAX_TYPE, ObjectInputMixin, check_view_bounds
+from ._objects import _MAX_TYPE, ObjectInputMixin, check_view_bounds, fitted_region
 
 __all__ = ["GridCounts"]
 
@@ -102,11 +102,10 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         if self._fitted_on_features:
             self.types_ = np.arange(self.n_features_in_)
             self.n_types_ = self.n_features_in_
-            if self.view_bounds is None:
-                x = data[:, 0].reshape(len(sets), -1)
+            if self.view_bounds is None:     # each column's range
+                spanned = fitted_region(data[:, 0].reshape(len(sets), -1), range(self.n_types_))
                 self.bounds_ = np.column_stack(
-                    [x.min(0), x.max(0), np.zeros((self.n_types_, 2))]
-                ).astype(np.float64)
+                    [spanned, np.zeros((self.n_types_, 2))]).astype(np.float64)
             else:
                 bounds = np.pad(check_view_bounds(self.view_bounds, 1), (0, 2))
                 self.bounds_ = np.tile(bounds, (self.n_types_, 1))
@@ -117,11 +116,11 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
             self.types_ = np.unique(data[:, d].astype(np.intp)) if len(data) else np.zeros(1, np.intp)
         self.n_types_ = len(self.types_)
         columns = list(self.columns_)
+        spanned = fitted_region(data, columns)
         if self.view_bounds is not None:
             bounds = check_view_bounds(self.view_bounds, len(columns))
-        elif len(data):
-            bounds = np.column_stack([data[:, columns].min(0), data[:, columns].max(0)]).ravel()
-            bounds = bounds.astype(np.float64)
+        elif spanned is not None:
+            bounds = spanned.ravel().astype(np.float64)
         else:
             raise ValueError("GridCounts needs view_bounds when X holds no object at all")
         self.bounds_ = np.tile(np.pad(bounds, (0, 4 - len(bounds))), (self.n_types_, 1))

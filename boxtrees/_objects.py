@@ -54,6 +54,16 @@ def _check_type_names(type_names, data):
     return names
 
 
+def fitted_region(rows, columns):
+    """The region the training objects span along ``columns`` of their ``rows`` (a feature
+    matrix's columns are one-attribute objects): ``(low, high)`` per column, shape
+    (len(columns), 2); None when there is no object."""
+    if not len(rows):
+        return None
+    values = rows[:, list(columns)]
+    return np.column_stack([values.min(axis=0), values.max(axis=0)])
+
+
 def _same_names(a, b):
     """Whether two batches' ``type_names`` are the same (both None, or equal labels)."""
     if a is None or b is None:
