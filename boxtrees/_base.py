@@ -383,7 +383,7 @@ class _TrainingObjects:
         d = estimator.n_attributes_
         if features:          # ``sets`` is the feature matrix: each column is one attribute
             estimator.types_ = np.arange(estimator.n_features_in_)
-            spanned = fitted_region(sets, range(sets.shape[1]))
+            spanned = fitted_region(sets)
         else:
             data = sets.data
             estimator.types_, position = np.unique(data[:, d].astype(np.intp), return_inverse=True)

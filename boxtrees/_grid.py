@@ -103,7 +103,7 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
             self.types_ = np.arange(self.n_features_in_)
             self.n_types_ = self.n_features_in_
             if self.view_bounds is None:     # each column's range
-                spanned = fitted_region(data[:, 0].reshape(len(sets), -1), range(self.n_types_))
+                spanned = fitted_region(data[:, 0].reshape(len(sets), -1))
                 self.bounds_ = np.column_stack(
                     [spanned, np.zeros((self.n_types_, 2))]).astype(np.float64)
             else:

@@ -54,13 +54,14 @@ def _check_type_names(type_names, data):
     return names
 
 
-def fitted_region(rows, columns):
+def fitted_region(rows, columns=None):
     """The region the training objects span along ``columns`` of their ``rows`` (a feature
     matrix's columns are one-attribute objects): ``(low, high)`` per column, shape
-    (len(columns), 2); None when there is no object."""
+    (n_columns, 2); None when there is no object. ``columns=None``: every column, read in
+    place (a feature matrix is not copied)."""
     if not len(rows):
         return None
-    values = rows[:, list(columns)]
+    values = rows if columns is None else rows[:, list(columns)]
     return np.column_stack([values.min(axis=0), values.max(axis=0)])
 
 
