@@ -374,10 +374,42 @@ cdef class _Splitter:
             t.proxy = split_proxy(wl, known, wr, other, self.n_outputs)
         return True
 
+    @cython.final
     cdef bint find_best(self, BoxTest* best) noexcept nogil:
         """The best of ``n_tests`` random tests, in up to ``1 + max_retries`` rounds until one
-        splits; False if none does. Ties within ``tie`` go to the test drawn first."""
-        return False
+        splits; False if none does. Ties within ``tie`` go to the test drawn first. Tests are
+        drawn and scored ``TEST_CHUNK`` at a time (`_score_chunk`: how is the subclass's
+        business); with ``refine``, the best one is then refined."""
+        cdef BoxTest tests[TEST_CHUNK]
+        cdef bint valid[TEST_CHUNK]
+        cdef intp_t r, first, m, k
+        cdef bint found = False
+        best.proxy = -INFINITY
+        if self.n_live == 0:
+            return False
+        for r in range(self.max_retries + 1):
+            first = 0
+            while first < self.n_tests:
+                m = min(<intp_t>TEST_CHUNK, self.n_tests - first)
+                first += m
+                self._score_chunk(tests, valid, m)
+                for k in range(m):
+                    if valid[k] and (not found or tests[k].proxy > best.proxy + self.tie):
+                        best[0] = tests[k]
+                        found = True
+            if found:
+                break
+        if found and self.refine:
+            self._start_refining(best)
+            self._refine(best)
+        return found
+
+    cdef void _score_chunk(self, BoxTest* tests, bint* valid, intp_t m) noexcept nogil:
+        """Draw ``m`` tests in order and score each: ``valid[k]`` says whether test ``k``
+        splits the node (its ``proxy`` is then set)."""
+
+    cdef void _start_refining(self, const BoxTest* best) noexcept nogil:
+        """Make ready to refine ``best`` (nothing to do by default)."""
 
     @cython.final
     cdef void _refine(self, BoxTest* best) noexcept nogil:
@@ -731,25 +763,11 @@ cdef class _ObjectSplitter(_Splitter):
                     right_sums[k] += right * self.weighted_target[s * n_outputs + k]
         return self._score(t, self.w_sum - wr, wr, True)
 
-    cdef bint find_best(self, BoxTest* best) noexcept nogil:
-        cdef BoxTest t
-        cdef intp_t r, k
-        cdef bint found = False
-        best.proxy = -INFINITY
-        if self.n_live == 0:
-            return False
-        for r in range(self.max_retries + 1):
-            for k in range(self.n_tests):
-                if not self.sample_test(&t) or not self.evaluate(&t):
-                    continue
-                if not found or t.proxy > best.proxy + self.tie:
-                    best[0] = t
-                    found = True
-            if found:
-                break
-        if found and self.refine:
-            self._refine(best)
-        return found
+    cdef void _score_chunk(self, BoxTest* tests, bint* valid, intp_t m) noexcept nogil:
+        """One test at a time: its box, then its threshold drawn on the node's counts."""
+        cdef intp_t k
+        for k in range(m):
+            valid[k] = self.sample_test(&tests[k]) and self.evaluate(&tests[k])
 
     cdef intp_t _collect(self, const BoxTest* t, intp_t side) noexcept nogil:
         """(The edges refined are x's and y's; the further columns of a larger group keep
@@ -857,6 +875,7 @@ cdef class _ColumnSplitter(_Splitter):
     cdef coord_t* node_max
     cdef bint local_x
     cdef bint unit_weights           # every weight is 1
+    cdef vector[pair[intp_t, intp_t]] by_column     # scratch of _score_chunk: (column, test)
 
     def __cinit__(self, objects, const intp_t[::1] segment_ptr, target, weight, params,
                   uint64 seed):
@@ -904,53 +923,36 @@ cdef class _ColumnSplitter(_Splitter):
                 self.live[self.n_live] = ty
                 self.n_live += 1
 
-    cdef bint find_best(self, BoxTest* best) noexcept nogil:
-        """Tests are drawn a chunk at a time and scored column by column: the node's values
-        of a column are gathered once (one strided read per sample) for all the chunk's tests
-        on it, which then read them contiguously."""
-        cdef BoxTest tests[TEST_CHUNK]
-        cdef bint valid[TEST_CHUNK]
-        cdef vector[pair[intp_t, intp_t]] by_column      # (column, test) of the chunk
+    cdef void _score_chunk(self, BoxTest* tests, bint* valid, intp_t m) noexcept nogil:
+        """The chunk's tests are drawn, then scored column by column: the node's values of a
+        column are gathered once (one strided read per sample) for all the chunk's tests on
+        it, which then read them contiguously."""
+        cdef vector[pair[intp_t, intp_t]]* by_column = &self.by_column
         cdef BoxTest* block[TEST_BLOCK]
-        cdef intp_t r, first, m, k, j, n, column
-        cdef bint found = False
-        best.proxy = -INFINITY
-        if self.n_live == 0:
-            return False
-        by_column.resize(TEST_CHUNK)
-        for r in range(self.max_retries + 1):
-            first = 0
-            while first < self.n_tests:
-                m = min(<intp_t>TEST_CHUNK, self.n_tests - first)
-                first += m
-                for k in range(m):
-                    self.sample_test(&tests[k])     # a column has an object in every sample
-                    by_column[k] = pair[intp_t, intp_t](tests[k].object_type, k)
-                sort(by_column.begin(), by_column.begin() + m)
-                j = 0
-                while j < m:              # the chunk's tests on one column, TEST_BLOCK at once
-                    column = by_column[j].first
-                    self._gather(column)
-                    while j < m and by_column[j].first == column:
-                        n = 1
-                        while n < TEST_BLOCK and j + n < m and by_column[j + n].first == column:
-                            n += 1
-                        for k in range(n):
-                            block[k] = &tests[by_column[j + k].second]
-                        self._score_gathered(block, n)
-                        for k in range(n):
-                            valid[by_column[j + k].second] = block[k].threshold == 1
-                        j += n
-                for k in range(m):
-                    if valid[k] and (not found or tests[k].proxy > best.proxy + self.tie):
-                        best[0] = tests[k]
-                        found = True
-            if found:
-                break
-        if found and self.refine:
-            self._gather(best.object_type)
-            self._refine(best)
-        return found
+        cdef intp_t k, j, n, column
+        by_column.resize(m)
+        for k in range(m):
+            self.sample_test(&tests[k])     # a column has an object in every sample
+            by_column[0][k] = pair[intp_t, intp_t](tests[k].object_type, k)
+        sort(by_column.begin(), by_column.end())
+        j = 0
+        while j < m:              # the chunk's tests on one column, TEST_BLOCK at once
+            column = by_column[0][j].first
+            self._gather(column)
+            while j < m and by_column[0][j].first == column:
+                n = 1
+                while n < TEST_BLOCK and j + n < m and by_column[0][j + n].first == column:
+                    n += 1
+                for k in range(n):
+                    block[k] = &tests[by_column[0][j + k].second]
+                self._score_gathered(block, n)
+                for k in range(n):
+                    valid[by_column[0][j + k].second] = block[k].threshold == 1
+                j += n
+
+    cdef void _start_refining(self, const BoxTest* best) noexcept nogil:
+        """The best test's column is gathered for `_collect`."""
+        self._gather(best.object_type)
 
     cdef intp_t _collect(self, const BoxTest* t, intp_t side) noexcept nogil:
         """(The gathered values are the best test's column.)"""
