@@ -31,6 +31,7 @@ from libcpp.vector cimport vector
 from ._rows import scan_offsets
 
 from ._criterion cimport node_statistics, split_proxy
+from ._simd cimport boxtrees_kernels, boxtrees_select_kernels
 from ._utils cimport (
     BOUNDED, CLASSIC, FIXED, RANDOM, TREE_LEAF, TREE_UNDEFINED,
     coord_t, float64_t, int32, intp_t, uint8, uint64,
@@ -117,18 +118,6 @@ cdef inline void _strip(const coord_t* x, intp_t lo, intp_t hi, coord_t xmin, co
 
 
 cnp.import_array()
-
-cdef extern from "_simd.h":
-    ctypedef struct boxtrees_kernels:
-        intp_t (*compact)(const coord_t* ys, const int32* sid, intp_t n, coord_t ymin,
-                          coord_t ymax, int32* out) noexcept nogil
-        intp_t (*compact_box)(const coord_t* xs, const coord_t* ys, const int32* sid, intp_t n,
-                              coord_t xmin, coord_t xmax, coord_t ymin, coord_t ymax,
-                              int32* out) noexcept nogil
-        intp_t (*partition)(coord_t* xs, coord_t* ys, int32* sid, intp_t n,
-                            const int32* new_id, int32 mid, coord_t* tmp_x, coord_t* tmp_y,
-                            int32* tmp_sid) noexcept nogil
-    boxtrees_kernels boxtrees_select_kernels(int allow_simd) noexcept nogil
 
 cdef enum:
     SHORT_SEGMENT = 160  # segments up to this long are scanned whole instead of searched

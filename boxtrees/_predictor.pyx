@@ -17,32 +17,12 @@ import numpy as np
 
 cimport numpy as cnp
 from libc.math cimport INFINITY
-from libc.stdint cimport int16_t
 
 from ._utils cimport (
     BAD_OFFSETS, MAX_TYPE, ROW_OK, ROW_TYPE_TOO_LARGE, TREE_LEAF, coord_t, float64_t, int32, intp_t,
     row_problem,
 )
-
-cdef extern from "_simd.h":
-    ctypedef struct boxtrees_node:
-        int32 left
-        int32 right
-        int32 object_type
-        int32 threshold
-        int16_t x_column
-        int16_t y_column
-        int32 extra
-        coord_t box[4]
-    ctypedef struct boxtrees_extra:
-        int32 column
-        coord_t low
-        coord_t high
-    ctypedef struct boxtrees_kernels:
-        intp_t (*find_leaf)(const boxtrees_node* nodes, const boxtrees_extra* extras,
-                            const coord_t* features, intp_t stride,
-                            const intp_t* types) noexcept nogil
-    boxtrees_kernels boxtrees_select_kernels(int allow_simd) noexcept nogil
+from ._simd cimport boxtrees_extra, boxtrees_kernels, boxtrees_node, boxtrees_select_kernels
 
 cnp.import_array()
 
