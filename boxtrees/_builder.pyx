@@ -198,7 +198,6 @@ cdef class _Splitter:
     cdef intp_t* type_size           # per type: the current node's number of objects
     cdef intp_t* live                # the types tests are drawn on in the current node
     cdef intp_t n_live
-    cdef const coord_t[:, ::1] bounds
     cdef intp_t n_samples
     cdef intp_t n_types
     cdef intp_t n_groups
@@ -247,7 +246,6 @@ cdef class _Splitter:
         self.type_size = <intp_t*>self._own(np.empty(n_types, dtype=np.intp))
         self.live = <intp_t*>self._own(np.arange(n_types, dtype=np.intp))
         self.n_live = n_types
-        self.bounds = bounds
         self.n_samples = n_samples
         self.n_types = n_types
         self.n_groups = n_groups
