@@ -440,7 +440,8 @@ class _TrainingObjects:
         self.band_edges = np.array([np.pad(e, (0, n_bands + 1 - len(e)), constant_values=np.inf)
                                     for e in edges])
         self.x, self.y, self.sample_of, object_of, self.segment_ptr = index_segments(
-            data, sets.sample_index().astype(np.int32), position, groups, n_types, edges)
+            data, sets.sample_index().astype(np.int32), position, groups, n_types,
+            self.band_edges)
         if (self.group_sizes > 2).any():   # their further columns are read in the rows
             self.attributes = np.ascontiguousarray(data[:, :estimator.n_attributes_])
             self.object_of = object_of

@@ -43,7 +43,7 @@ TEST_KINDS = {"random": RANDOM, "fixed": FIXED, "bounded": BOUNDED, "classic": C
 
 cdef enum:
     MAX_GROUP = 8         # the columns a box may span: x, y and up to 6 more
-    MAX_EXTRA = 6         # MAX_GROUP - 2
+    MAX_EXTRA = MAX_GROUP - 2
 
 MAX_GROUP_COLUMNS = MAX_GROUP
 

@@ -18,9 +18,9 @@ def index_segments(data, sample, position, groups, n_types, band_edges):
     groups : sequence of tuple of int
         The column groups: a group's x is its first column, its y its second (none: all 0).
     n_types : int
-    band_edges : sequence of ndarray
-        Per group, the edges of its y bands, from -inf to +inf (``n_bands + 1`` of them for
-        the group with the most; the bands past a group's own are empty).
+    band_edges : ndarray of shape (n_groups, n_bands + 1)
+        Per group, the edges of its y bands, from -inf to +inf (a group with fewer bands
+        ends in +inf edges: the bands past its own are empty).
 
     Returns
     -------
@@ -31,7 +31,7 @@ def index_segments(data, sample, position, groups, n_types, band_edges):
         Segment ``g = (group * n_types + type) * n_bands + band`` is
         ``segment_ptr[g]:segment_ptr[g + 1]``.
     """
-    n_bands = max(len(edges) for edges in band_edges) - 1
+    n_bands = band_edges.shape[1] - 1
     xs, ys, samples, objects, segments = [], [], [], [], []
     for g, columns in enumerate(groups):
         x = data[:, columns[0]]

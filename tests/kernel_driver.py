@@ -45,7 +45,7 @@ def training_arrays(rng, n, per_sample, n_types, n_bands, spread, groups):
     sample = np.repeat(np.arange(n), sizes).astype(np.int32)
     edges = np.concatenate([[-np.inf], np.linspace(-1, 1, n_bands + 1)[1:-1], [np.inf]])
     one_band = np.concatenate([[-np.inf], np.full(n_bands, np.inf)])
-    band_edges = [edges if len(columns) > 1 else one_band for columns in groups]
+    band_edges = np.array([edges if len(columns) > 1 else one_band for columns in groups])
     x, y, sample_of, object_of, segment_ptr = _index.index_segments(
         data, sample, data[:, d].astype(np.intp), groups, n_types, band_edges)
     width = _builder.MAX_GROUP_COLUMNS
@@ -56,7 +56,7 @@ def training_arrays(rng, n, per_sample, n_types, n_bands, spread, groups):
             bounds[g * n_types:(g + 1) * n_types, 2:4] = [-np.inf, np.inf]
         extra[g, :max(len(columns) - 2, 0)] = columns[2:]
     objects = SimpleNamespace(x=x, y=y, sample_of=sample_of, segment_ptr=segment_ptr,
-                              band_edges=np.array(band_edges), bounds=bounds,
+                              band_edges=band_edges, bounds=bounds,
                               half_widths=np.full((len(bounds), width), 0.7),
                               group_sizes=[len(columns) for columns in groups],
                               attributes=np.ascontiguousarray(data[:, :d]),
