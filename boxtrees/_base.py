@@ -18,7 +18,8 @@ from sklearn.utils.validation import _check_sample_weight, check_is_fitted
 
 from ._builder import MAX_GROUP_COLUMNS, TEST_KINDS, build_tree
 from ._index import index_segments
-from ._objects import _FLOAT32_MAX, ObjectInputMixin, check_view_bounds, fitted_region, row_error
+from ._objects import (_FLOAT32_MAX, ObjectInputMixin, check_view_bounds, columns_of,
+                       fitted_region, row_error)
 from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
 from ._tree import BoxTree
@@ -468,20 +469,14 @@ def _column_groups(column_groups, n_attributes):
         return ((0, 1),) + tuple((0, 1, c) for c in range(2, n_attributes))
     groups = []
     for group in column_groups:
-        group = (group,) if isinstance(group, Integral) else group
-        try:
-            group = tuple(group)
-        except TypeError:
-            group = None
-        if (not group or len(group) > most
-                or not all(isinstance(c, Integral) and 0 <= c < n_attributes for c in group)
-                or len(set(group)) != len(group)):
+        group = columns_of(group, n_attributes, most)
+        if group is None:
             raise ValueError(
                 f"column_groups must be a non-empty sequence of groups of 1 to {most} distinct "
                 f"attribute indices in [0, {n_attributes}) (the objects have {n_attributes} "
                 f"attributes before their type); got {column_groups!r}"
             )
-        groups.append(tuple(int(c) for c in group))
+        groups.append(group)
     if not groups:
         raise ValueError("column_groups must name at least one group of columns; got "
                          f"{column_groups!r}")

@@ -6,7 +6,7 @@ from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 
-from ._objects import _MAX_TYPE, ObjectInputMixin, check_view_bounds, fitted_region
+from ._objects import _MAX_TYPE, ObjectInputMixin, check_view_bounds, columns_of, fitted_region
 
 __all__ = ["GridCounts"]
 
@@ -181,13 +181,12 @@ def _grid_columns(columns, n_attributes):
     of one attribute."""
     if columns is None:
         return (0, 1) if n_attributes >= 2 else (0,)
-    columns = tuple(columns)
-    if (not 1 <= len(columns) <= 2 or len(set(columns)) != len(columns)
-            or not all(isinstance(c, Integral) and 0 <= c < n_attributes for c in columns)):
+    checked = columns_of(columns, n_attributes, 2)
+    if checked is None:
         raise ValueError(f"columns must be one or two distinct attribute indices in "
                          f"[0, {n_attributes}) (the objects have {n_attributes} attributes "
                          f"before their type); got {columns!r}")
-    return tuple(int(c) for c in columns)
+    return checked
 
 
 def _cell(v, low, high, n_bins):

@@ -65,6 +65,20 @@ def fitted_region(rows, columns=None):
     return np.column_stack([values.min(axis=0), values.max(axis=0)])
 
 
+def columns_of(group, n_attributes, most):
+    """``group`` (an int, or a sequence of ints) as a tuple of 1 to ``most`` distinct
+    attribute indices in ``[0, n_attributes)``, or None when it is not one."""
+    group = (group,) if isinstance(group, Integral) else group
+    try:
+        group = tuple(group)
+    except TypeError:
+        return None
+    if (not group or len(group) > most or len(set(group)) != len(group)
+            or not all(isinstance(c, Integral) and 0 <= c < n_attributes for c in group)):
+        return None
+    return tuple(int(c) for c in group)
+
+
 def _same_names(a, b):
     """Whether two batches' ``type_names`` are the same (both None, or equal labels)."""
     if a is None or b is None:

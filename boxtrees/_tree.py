@@ -27,7 +27,7 @@ class BoxTree:
         Test box ``(low_1, high_1, ..., low_d, high_d)``, open on every side (for
         objects ``[x, y, type]``: ``(xmin, xmax, ymin, ymax)``); infinite bounds mean
         unbounded (the attributes outside the test's column group, classic half-plane
-        tests). A box bounds at most two attributes. Zeros at leaves.
+        tests). Zeros at leaves.
     threshold : ndarray of shape (node_count,)
         Integer count threshold ``z``; ``-2`` at leaves.
     value : ndarray of shape (node_count,) or (node_count, n_outputs)
