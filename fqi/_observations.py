@@ -22,8 +22,7 @@ def _observation_format(space):
     if isinstance(space, spaces.Box):
         return _FeatureRows(space)
     if isinstance(space, spaces.Sequence) and isinstance(space.feature_space, spaces.Box):
-        _row_box(space)     # rows of at least 2 numbers [f_1, ..., f_d, type]
-        return _ObjectRows(space)
+        return _ObjectRows(space)     # (which checks its rows)
     raise TypeError(f"FQI takes Box observations (feature vectors) or Sequence(Box(shape=(d + "
                     f"1,))) (object sets of [f_1, ..., f_d, type] rows); got {space}: wrap the env in "
                     f"gymnasium.wrappers.FlattenObservation (for Dict, Tuple, Discrete, "
@@ -150,15 +149,16 @@ def _row_box(space):
     return space.feature_space
 
 
-def _view_bounds(space):
-    """The sampling region of object-set observations: ``(low, high)`` of each attribute of
-    their rows, ``(xmin, xmax, ymin, ymax)`` for ``[x, y, type]``."""
+def _view_bounds(space, n_columns=None):
+    """The sampling region of object-set observations: ``(low, high)`` of each of the first
+    ``n_columns`` attributes of their rows (None: all), ``(xmin, xmax, ymin, ymax)`` for
+    ``[x, y, type]``."""
     box = _row_box(space)
-    d = box.shape[0] - 1
-    view_bounds = tuple(float(v) for c in range(d) for v in (box.low[c], box.high[c]))
+    columns = range(box.shape[0] - 1 if n_columns is None else n_columns)
+    view_bounds = tuple(float(v) for c in columns for v in (box.low[c], box.high[c]))
     if not np.isfinite(view_bounds).all():
-        raise ValueError(f"the object rows of {space} have unbounded attributes; give "
-                         f"view_bounds=(low_1, high_1, ..., low_d, high_d)")
+        raise ValueError(f"the object rows of {space} have unbounded attributes among the "
+                         f"first {len(columns)}; give view_bounds, (low, high) of each")
     return view_bounds
 
 
@@ -174,11 +174,7 @@ def _object_bounds(space, view_bounds=None, n_types=None):
     """
     box = _row_box(space)
     if view_bounds is None:
-        columns = range(min(box.shape[0] - 1, 2))
-        view_bounds = tuple(float(v) for c in columns for v in (box.low[c], box.high[c]))
-        if not np.isfinite(view_bounds).all():
-            raise ValueError(f"the object rows of {space} have unbounded x or y; give "
-                             f"view_bounds=(xmin, xmax, ymin, ymax)")
+        view_bounds = _view_bounds(space, min(box.shape[0] - 1, 2))
     if n_types is None:
         if not np.isfinite(box.high[-1]):
             raise ValueError(f"the object rows of {space} have an unbounded type; give "

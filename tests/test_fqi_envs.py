@@ -212,6 +212,16 @@ def test_objects_of_more_attributes_learn_end_to_end():
     assert make_grid_ridge(MovingCoins)[0].view_bounds == (-5.0, 5.0, -5.0, 5.0)
 
 
+def test_an_unbounded_attribute_needs_view_bounds_for_the_forest_not_for_the_grid():
+    env = MovingCoins()
+    row = spaces.Box(np.array([-5, -5, -np.inf, 0], dtype=np.float32),
+                     np.array([5, 5, np.inf, 1], dtype=np.float32))
+    env.observation_space = spaces.Sequence(row, stack=True)
+    with pytest.raises(ValueError, match="unbounded attributes among the first 3; give view_bounds"):
+        make_box_forest(env)
+    assert make_grid_ridge(env)[0].view_bounds == (-5.0, 5.0, -5.0, 5.0)
+
+
 # ---------------------------------------------------------------- vector envs and autoreset
 def _plain_rollouts(seeds, policy, n_steps):
     """Per env: the transitions of a plain step-by-step rollout (reset with its seed, then
