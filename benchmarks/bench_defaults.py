@@ -63,7 +63,7 @@ def motion_task(seed, n):
 
 
 def scaled(sets, factor):
-    """The sets with every attribute multiplied by ``factor``."""
+    """The sets with their attributes multiplied by ``factor`` (a number, or one per attribute)."""
     return [np.column_stack([s[:, :-1] * factor, s[:, -1]]) for s in sets]
 
 

@@ -4,22 +4,9 @@ import numpy as np
 import pytest
 from sklearn.metrics import r2_score
 
+from benchmarks.bench_defaults import coin_task, scaled
 from benchmarks.bench_sets import make_data
 from boxtrees import BoxExtraTreesClassifier, BoxExtraTreesRegressor
-
-
-def coin_task(seed, n):
-    """The README's task: objects of type 0 in the unit square at the origin, among sets of
-    up to 12 objects of types 0 and 1 in [-3, 3]^2."""
-    rng = np.random.default_rng(seed)
-    sets = [np.column_stack([rng.uniform(-3, 3, (k, 2)), rng.integers(0, 2, k)])
-            for k in rng.integers(0, 12, n)]
-    coins = [float(((np.abs(s[:, :2]).max(1) < 1) & (s[:, 2] == 0)).sum()) for s in sets]
-    return sets, np.array(coins)
-
-
-def scaled(sets, factors):
-    return [np.column_stack([s[:, :-1] * factors, s[:, -1]]) for s in sets]
 
 
 @pytest.mark.parametrize("test_type", ["random", "fixed", "bounded", "classic"])
@@ -29,8 +16,8 @@ def test_the_defaults_give_the_same_model_in_any_units(test_type):
     scores = {}
     for factors in ([1.0, 1.0], [100.0, 100.0], [0.01, 0.01], [100.0, 0.01]):
         forest = BoxExtraTreesRegressor(10, test_type=test_type, random_state=0)
-        forest.fit(scaled(X, factors), y)
-        scores[tuple(factors)] = r2_score(y_test, forest.predict(scaled(X_test, factors)))
+        forest.fit(scaled(X, np.array(factors)), y)
+        scores[tuple(factors)] = r2_score(y_test, forest.predict(scaled(X_test, np.array(factors))))
     original = scores[(1.0, 1.0)]
     assert original > (0.5 if test_type == "classic" else 0.9), scores   # (half-planes: coarse)
     assert all(abs(score - original) <= 0.02 for score in scores.values()), scores
@@ -43,10 +30,10 @@ def test_widths_in_the_data_units_are_what_the_thesis_ran():
     X_test, y_test = coin_task(1, 500)
     absolute = BoxExtraTreesRegressor(10, test_type="fixed", test_width=1.0, relative_width=False,
                                       refine_tests=False, bootstrap=False,
-                                      random_state=0).fit(scaled(X, [100, 100]), y)
+                                      random_state=0).fit(scaled(X, np.array([100, 100])), y)
     relative = BoxExtraTreesRegressor(10, test_type="fixed", random_state=0).fit(
-        scaled(X, [100, 100]), y)
-    pixels = scaled(X_test, [100, 100])
+        scaled(X, np.array([100, 100])), y)
+    pixels = scaled(X_test, np.array([100, 100]))
     assert r2_score(y_test, relative.predict(pixels)) > r2_score(y_test, absolute.predict(pixels)) + 0.5
 
 
