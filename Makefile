@@ -9,7 +9,7 @@ SOURCES := setup.py pyproject.toml constraints.txt $(wildcard boxtrees/*.pyx box
 .PHONY: bench test install clean
 
 bench: $(VENV)/.installed
-	$(PY) benchmarks/run_all.py --quick --jobs 2
+	$(PY) -m benchmarks.run_all --quick --jobs 2
 
 test: $(VENV)/.installed
 	$(PY) -m pytest -q tests

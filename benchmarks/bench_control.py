@@ -25,15 +25,14 @@ policy, 20 iterations; compared by the return of the greedy policy and the secon
 MushroomRL 1.10.2 pins an old torch and numpy, so install it without them:
 ``.venv/bin/pip install --no-deps mushroom-rl==1.10.2 opencv-python-headless pygame``.
 
-    python benchmarks/bench_control.py                                     # full: hours
-    python benchmarks/bench_control.py --envs CartPole-v1 --seeds 0 --steps 3000 --eval-every 1000
+    python -m benchmarks.bench_control                                     # full: hours
+    python -m benchmarks.bench_control --envs CartPole-v1 --seeds 0 --steps 3000 --eval-every 1000
 
 Writes ``bench_control.json`` and ``bench_control.png`` (return against env steps) under
 ``--out``, and each finished run under ``--out/runs/``: a rerun with the same arguments reuses
 those, so an interrupted full run resumes where it stopped.
 """
 import argparse
-import contextlib
 import json
 import math
 import os
@@ -47,10 +46,10 @@ import numpy as np
 from sklearn.ensemble import ExtraTreesRegressor
 from tqdm.auto import tqdm
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from fqi import FQI, evaluate, make_box_forest
 
-from benchmarks.zoo_hyperparams import ZOO_DQN  # noqa: E402
-from fqi import FQI, evaluate, make_box_forest  # noqa: E402
+from .training import EvalCallback, timed_learn, train_sb3
+from .zoo_hyperparams import ZOO_DQN
 
 # Tuned DQN: rl-zoo3's settings for each env (benchmarks/zoo_hyperparams.py; policy
 # "MlpPolicy", its n_timesteps replaced by the budget below, the same for every agent).
@@ -64,9 +63,9 @@ ENVS = {
     "MountainCar-v0": {"steps": 120_000, "threshold": -110.0, "samples": 2000},
 }
 AGENTS = ("fqi-sklearn", "fqi-box", "dqn")
-# FQI draws its training reset seeds below 2**40 and DQN's env is seeded with the run's seed:
-# these episodes are played by no agent in training.
-EVAL_SEEDS = tuple(range(2**40, 2**40 + 20))
+# `fqi.evaluate`'s held-out seeds: FQI draws its training reset seeds below them and DQN's
+# env is seeded with the run's seed, so these episodes are played by no agent in training.
+EVAL_EPISODES = 20
 FQI_ENVS, FQI_MAX_SAMPLES = 8, 100_000
 PEER_SAMPLES, PEER_ITERATIONS = 10_000, 20
 
@@ -79,38 +78,11 @@ def make_regressor(name):
                            min_samples_split=10, n_jobs=1)
 
 
-class Checkpoints:
-    """Evaluates a policy on the held-out seeds each time training passes a multiple of
-    `every` environment steps, and times training without its evaluations, in wall and CPU
-    seconds (CPU time does not count what other jobs on the machine take)."""
-
-    def __init__(self, env_id, every, bar):
-        self.env = gym.make_vec(env_id, len(EVAL_SEEDS), vectorization_mode="sync")
-        self.every, self.bar = every, bar
-        self.curve, self._next, self._steps = [], every, 0
-        self.seconds = self.cpu_seconds = 0.0  # of the evaluations
-        self.train_seconds = self.train_cpu_seconds = None
-
-    @contextlib.contextmanager
-    def timed(self):
-        start, cpu_start = time.perf_counter(), time.process_time()
-        yield
-        self.train_seconds = time.perf_counter() - start - self.seconds
-        self.train_cpu_seconds = time.process_time() - cpu_start - self.cpu_seconds
-
-    def __call__(self, policy, steps, last=False):
-        self.bar.update(steps - self._steps)
-        self._steps = steps
-        due = steps >= self._next or (last and (not self.curve or self.curve[-1][0] != steps))
-        if not due:
-            return
-        start, cpu_start = time.perf_counter(), time.process_time()
-        mean = evaluate(policy, self.env, seeds=EVAL_SEEDS).mean
-        self.seconds += time.perf_counter() - start
-        self.cpu_seconds += time.process_time() - cpu_start
-        self.curve.append([int(steps), mean])
-        self._next = (steps // self.every + 1) * self.every
-        self.bar.set_postfix(steps=f"{steps:,}", mean_return=f"{mean:.1f}")
+def evaluations(env_id, every):
+    """The held-out evaluation of every agent: the greedy policy's mean return on
+    `EVAL_EPISODES` seeds, every `every` environment steps and at the end."""
+    return EvalCallback(gym.make_vec(env_id, EVAL_EPISODES, vectorization_mode="sync"), every,
+                        n_episodes=EVAL_EPISODES)
 
 
 def exploration(env_id, steps):
@@ -121,58 +93,40 @@ def exploration(env_id, steps):
     return lambda n: max(final, 1.0 - (1.0 - final) * n / span)
 
 
-def run_fqi(env_id, agent_name, seed, steps, checkpoints):
+def run_fqi(env_id, agent_name, seed, steps, curve):
+    """An FQI agent's run; its training seconds (wall, CPU)."""
     samples = min(ENVS[env_id]["samples"], steps)
     epsilon = exploration(env_id, steps)
     agent = FQI(make_regressor(agent_name), env_id, gamma=DQN_HYPERPARAMS[env_id]["gamma"],
                 epsilon=1.0, samples_per_iteration=samples, keep_data=True,
                 max_samples=FQI_MAX_SAMPLES, n_envs=FQI_ENVS, eval_episodes=0, seed=seed)
 
-    def after_iteration(locals_, globals_):
+    def explore(locals_, globals_):
         agent.epsilon = epsilon(agent.num_timesteps)  # the next collection's
-        checkpoints(agent, agent.num_timesteps)
 
-    with checkpoints.timed():
-        agent.learn(math.ceil(steps / samples), callback=after_iteration)
-        checkpoints(agent, agent.num_timesteps, last=True)
-    return agent.num_timesteps
+    return timed_learn(agent, [explore, curve], n_iterations=math.ceil(steps / samples))
 
 
-def run_dqn(env_id, seed, steps, checkpoints):
-    import torch
-    from stable_baselines3 import DQN
-    from stable_baselines3.common.callbacks import BaseCallback
-    from stable_baselines3.common.logger import Logger
-
-    class Evaluations(BaseCallback):
-        def _on_step(self):
-            checkpoints(self.model, self.num_timesteps)
-            return True
-
-    torch.set_num_threads(1)
-    model = DQN("MlpPolicy", gym.make(env_id), seed=seed, device="cpu",
-                **DQN_HYPERPARAMS[env_id])
-    model.set_logger(Logger(None, []))  # SB3's default logger makes a folder per run
-    with checkpoints.timed():
-        model.learn(total_timesteps=steps, callback=Evaluations())
-        checkpoints(model, model.num_timesteps, last=True)
-    return model.num_timesteps
+def run_dqn(env_id, seed, steps, curve):
+    """The tuned DQN's run; its training seconds (wall, CPU)."""
+    _, seconds, cpu_seconds = train_sb3("DQN", lambda: gym.make(env_id), steps,
+                                        DQN_HYPERPARAMS[env_id], seed=seed, callback=curve)
+    return seconds, cpu_seconds
 
 
 def run(env_id, agent_name, seed, steps, every):
-    with tqdm(total=steps, desc=f"{env_id} {agent_name} seed {seed}", leave=False) as bar:
-        checkpoints = Checkpoints(env_id, min(every, steps), bar)
-        if agent_name == "dqn":
-            env_steps = run_dqn(env_id, seed, steps, checkpoints)
-        else:
-            env_steps = run_fqi(env_id, agent_name, seed, steps, checkpoints)
+    curve = evaluations(env_id, min(every, steps))
+    if agent_name == "dqn":
+        seconds, cpu_seconds = run_dqn(env_id, seed, steps, curve)
+    else:
+        seconds, cpu_seconds = run_fqi(env_id, agent_name, seed, steps, curve)
     threshold = ENVS[env_id]["threshold"]
-    solved = next((s for s, mean in checkpoints.curve if mean >= threshold), None)
-    return {"env": env_id, "agent": agent_name, "seed": seed, "env_steps": env_steps,
-            "curve": checkpoints.curve, "final_mean": checkpoints.curve[-1][1],
-            "steps_to_threshold": solved, "train_seconds": checkpoints.train_seconds,
-            "train_cpu_seconds": checkpoints.train_cpu_seconds,
-            "eval_seconds": checkpoints.seconds}
+    solved = next((s for s, mean in curve.evaluations if mean >= threshold), None)
+    return {"env": env_id, "agent": agent_name, "seed": seed,
+            "env_steps": curve.evaluations[-1][0], "curve": curve.evaluations,
+            "final_mean": curve.evaluations[-1][1], "steps_to_threshold": solved,
+            "train_seconds": seconds, "train_cpu_seconds": cpu_seconds,
+            "eval_seconds": curve.eval_seconds}
 
 
 def run_peer(seed, samples):
@@ -188,7 +142,7 @@ def run_peer(seed, samples):
     except ImportError:
         return None
     env_id, gamma = "CartPole-v1", DQN_HYPERPARAMS["CartPole-v1"]["gamma"]
-    eval_env = gym.make_vec(env_id, len(EVAL_SEEDS), vectorization_mode="sync")
+    eval_env = gym.make_vec(env_id, EVAL_EPISODES, vectorization_mode="sync")
 
     class Gymnasium(Environment):
         """A gymnasium env as a MushroomRL MDP (absorbing = terminated; the time limit is
@@ -238,9 +192,9 @@ def run_peer(seed, samples):
     ours_seconds = np.mean([r["t_targets"] + r["t_fit"] for r in ours.history])
     return {"seed": seed, "samples": samples, "iterations": PEER_ITERATIONS,
             "mushroom_mean": evaluate(Greedy(mushroom.approximator), eval_env,
-                                      seeds=EVAL_SEEDS).mean,
+                                      n_episodes=EVAL_EPISODES).mean,
             "mushroom_seconds_per_iteration": mushroom_seconds,
-            "ours_mean": evaluate(ours, eval_env, seeds=EVAL_SEEDS).mean,
+            "ours_mean": evaluate(ours, eval_env, n_episodes=EVAL_EPISODES).mean,
             "ours_seconds_per_iteration": float(ours_seconds)}
 
 
@@ -356,7 +310,7 @@ def main(argv=None):
     table = markdown(summary, peers)
     print(table)
     report = {"benchmark": "bench_control", "args": vars(args), "envs": ENVS,
-              "dqn_hyperparams": DQN_HYPERPARAMS, "eval_seeds": list(EVAL_SEEDS),
+              "dqn_hyperparams": DQN_HYPERPARAMS, "eval_episodes": EVAL_EPISODES,
               "fqi": {"n_envs": FQI_ENVS, "max_samples": FQI_MAX_SAMPLES,
                       "regressors": {name: repr(make_regressor(name))
                                      for name in AGENTS[:2]}},

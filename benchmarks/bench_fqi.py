@@ -13,26 +13,27 @@ setting of the experiment registry (``benchmarks/reproduce/registry.py``), built
 Prints the phase times of every iteration and a summary, writes ``bench_fqi.json`` and the
 reward curves ``bench_fqi.png`` under ``--out``.
 
-    python benchmarks/bench_fqi.py                          # box + dqn, thesis scale
-    python benchmarks/bench_fqi.py --runs box box-mixed box-keep --dqn-steps 100000
-    python benchmarks/bench_fqi.py --quick                  # small smoke run
+    python -m benchmarks.bench_fqi                          # box + dqn, thesis scale
+    python -m benchmarks.bench_fqi --runs box box-mixed box-keep --dqn-steps 100000
+    python -m benchmarks.bench_fqi --quick                  # small smoke run
 """
 import argparse
 import json
 import platform
-import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import envs
+from fqi import RandomPolicy, evaluate
 
-import envs  # noqa: E402
-from benchmarks.reproduce.budgets import BUDGETS  # noqa: E402
-from benchmarks.reproduce.registry import REGISTRY  # noqa: E402
-from benchmarks.reproduce.units import make_agent  # noqa: E402
-from fqi import RandomPolicy, evaluate, train_dqn  # noqa: E402
+from .reproduce.budgets import BUDGETS
+from .reproduce.kinds import KINDS
+from .reproduce.kinds._game import make_agent
+from .reproduce.registry import REGISTRY
+from .reproduce.units import Unit, run_unit
 
 ENV = "ObjectWorld-v0"
 REFERENCE_WORLDS = envs.reference_worlds(400)  # the thesis's 400 evaluation episodes of 50 steps
@@ -46,6 +47,7 @@ FQI_RUNS = {
     "grid-ridge": ("representations", "grid 10 + ridge", {}),
     "classic": ("representations", "classic", {}),
 }
+DQN_RUN = ("dqn", "DQN (grid 10 obs)")
 THESIS_LEVEL, HUMAN_LEVEL = 100_000, 150_000
 
 
@@ -53,7 +55,7 @@ def run_fqi(name, iterations, samples, seed):
     """One FQI run; returns its summary with the per-iteration records."""
     experiment, label, changes = FQI_RUNS[name]
     params = {**REGISTRY[experiment].params(label), **changes}
-    agent = make_agent(params, BUDGETS["full"], seed, samples)
+    agent = make_agent(KINDS["fqi"].settings(params), BUDGETS["full"], seed, samples)
     print(f"\n== {name}: {agent!r}")
     print(f"{'it':>3} {'reward':>10} {'samples':>8} {'nodes/tree':>10} "
           + " ".join(f"{p[2:]:>9}" for p in PHASES) + f" {'total':>7}")
@@ -77,14 +79,17 @@ def run_fqi(name, iterations, samples, seed):
 
 
 def run_dqn(steps, seed):
+    """The registry's DQN setting (stable-baselines3 DQN on 10 x 10 grid counts) for
+    `steps` environment steps, scored on the 400 reference worlds."""
     print(f"\n== dqn: stable-baselines3 DQN on GridObservation(n_bins=10), {steps:,} steps")
-    result = train_dqn(ENV, total_timesteps=steps, eval_seeds=REFERENCE_WORLDS, seed=seed)
-    print(f"reward {result.reward:,.0f}  train {result.train_seconds:.1f}s  "
-          f"evaluate {result.eval_seconds:.1f}s", flush=True)
-    return {"name": "dqn", "kind": "dqn", "reward": result.reward,
-            "seconds": result.train_seconds + result.eval_seconds,
-            "train_seconds": result.train_seconds, "eval_seconds": result.eval_seconds,
-            "env_steps": steps}
+    budget, (experiment, label) = replace(BUDGETS["full"], dqn_steps=steps), DQN_RUN
+    result = run_unit(Unit(experiment, label, seed, REGISTRY[experiment].params(label, budget),
+                           budget.samples, budget, path=None))
+    print(f"reward {result['reward']:,.0f}  train {result['train_seconds']:.1f}s  "
+          f"evaluate {result['eval_seconds']:.1f}s", flush=True)
+    return {"name": "dqn", "kind": "dqn", "reward": result["reward"],
+            "seconds": result["seconds"], "train_seconds": result["train_seconds"],
+            "eval_seconds": result["eval_seconds"], "env_steps": steps}
 
 
 def plot(runs, anchors, path):

@@ -15,7 +15,7 @@ worlds. Times: wall and CPU seconds of the planner (numpy on one core). Prints t
 writes, under ``--out``, ``bench_planner_sweep_<game>.json`` and ``.png`` (reward vs simulated
 steps per decision) for the sweep and ``bench_planner_<game>.json`` for the chosen setting.
 
-    python benchmarks/bench_planner.py [--games 4-actions sword] [--episodes 400]
+    python -m benchmarks.bench_planner [--games 4-actions sword] [--episodes 400]
         [--depth 5] [--width 16] [--sweep-episodes 40] [--sweep 1x1 2x4 3x4 5x16 8x16 8x64]
         [--out results]
 """
@@ -30,10 +30,9 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import envs
 
-import envs  # noqa: E402
-from benchmarks.calibrate_env import policy_totals  # noqa: E402
+from .calibrate_env import policy_totals
 
 GAMES = {"4-actions": {}, "sword": {"sword": True}}
 HUMAN_PER_EPISODE = {"4-actions": 150_000 / 400}  # thesis: about 150,000 over 400 episodes

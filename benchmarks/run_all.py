@@ -1,11 +1,11 @@
 """Reproduce every experiment of the thesis, with plots and a report, in one command.
 
-    python benchmarks/run_all.py --quick --jobs 2 # every experiment, reduced budget, ~7 min
-    python benchmarks/run_all.py                  # the thesis's budgets (many hours; resumable)
-    python benchmarks/run_all.py --only representations,dqn --out docs/results
-    python benchmarks/run_all.py --report-only    # rebuild figures and REPORT.md from the cache
-    python benchmarks/run_all.py --dask-local 2   # the runs on a local Dask cluster of 2 workers
-    python benchmarks/run_all.py --scheduler tcp://host:8786   # ... on a Dask cluster
+    python -m benchmarks.run_all --quick --jobs 2 # every experiment, reduced budget, ~7 min
+    python -m benchmarks.run_all                  # the thesis's budgets (many hours; resumable)
+    python -m benchmarks.run_all --only representations,dqn --out docs/results
+    python -m benchmarks.run_all --report-only    # rebuild figures and REPORT.md from the cache
+    python -m benchmarks.run_all --dask-local 2   # the runs on a local Dask cluster of 2 workers
+    python -m benchmarks.run_all --scheduler tcp://host:8786   # ... on a Dask cluster
 
 Writes under ``--out`` (default ``results/``): one PNG per figure, ``runs/`` (one JSON per
 finished run, reused by later invocations), one CSV of raw numbers per experiment,
@@ -17,12 +17,7 @@ written, the cluster cannot run the units, or a run was skipped after crashing 3
 report counts it as missing), 130 on Ctrl-C (an interrupt is no crash; finished runs stay
 cached).
 """
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from benchmarks.reproduce.cli import main  # noqa: E402
+from .reproduce.cli import main
 
 if __name__ == "__main__":
     main()

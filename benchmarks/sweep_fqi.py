@@ -5,8 +5,8 @@ ObjectWorld-v0, `--iterations` iterations of `--samples` samples, several seeds 
 setting; the score of a run is the mean evaluation reward (20,000 greedy steps on the
 reference worlds) over its last 5 iterations.
 
-    python benchmarks/sweep_fqi.py gamma  [--values 0.5 0.8 0.9 0.95] [--seeds 0 1 2 3]
-    python benchmarks/sweep_fqi.py regime [--values normal mixed keep offline] [--seeds 0 1]
+    python -m benchmarks.sweep_fqi gamma  [--values 0.5 0.8 0.9 0.95] [--seeds 0 1 2 3]
+    python -m benchmarks.sweep_fqi regime [--values normal mixed keep offline] [--seeds 0 1]
         [--iterations 10] [--samples 10000] [--trees 10] [--out results]
 
 The gamma sweep runs the "normal" regime; the regime sweep uses the harness's gamma (0.5).
@@ -16,17 +16,15 @@ under ``--out``.
 """
 import argparse
 import json
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from benchmarks.reproduce.budgets import BUDGETS  # noqa: E402
-from benchmarks.reproduce.registry import REGISTRY  # noqa: E402
-from benchmarks.reproduce.units import make_agent  # noqa: E402
+from .reproduce.budgets import BUDGETS
+from .reproduce.kinds import KINDS
+from .reproduce.kinds._game import make_agent
+from .reproduce.registry import REGISTRY
 
 ENV = "ObjectWorld-v0"
 # each regime: (experiment, setting) of the registry, and what it changes on top of it
@@ -67,8 +65,8 @@ def main():
     for value in values:
         for seed in args.seeds:
             start = time.perf_counter()
-            agent = make_agent(_params(settings(value), args.trees), BUDGETS["full"], seed,
-                               args.samples)
+            agent = make_agent(KINDS["fqi"].settings(_params(settings(value), args.trees)),
+                               BUDGETS["full"], seed, args.samples)
             curve = [r["reward"] for r in agent.learn(args.iterations).history]
             seconds = time.perf_counter() - start
             last = float(np.mean(curve[-5:]))

@@ -109,16 +109,41 @@ class BoxTree:
             depth[node] = depth[parent[node]] + 1
         return depth
 
+    def split_gains(self):
+        """Each node's weighted impurity decrease, ``w_n i_n - w_l i_l - w_r i_r`` (``w``: the
+        weighted samples reaching a node, ``i``: its impurity; ``l``, ``r``: its children),
+        0 at the leaves, shape (node_count,): what its test gains, in the units of the
+        training weights and targets.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from boxtrees import BoxExtraTreeRegressor
+        >>> X = [np.array([[0.0, 0.0, 0]]), np.empty((0, 3))] * 20
+        >>> tree = BoxExtraTreeRegressor(min_samples_split=2, random_state=0).fit(
+        ...     X, [1.0, 0.0] * 20).tree_
+        >>> float(tree.split_gains()[0])  # the root's test separates the targets
+        10.0
+        """
+        return self._gains(self.weighted_n_node_samples, self.impurity)
+
+    def _gains(self, weight, impurity):
+        """`split_gains` from the nodes' `weight` and `impurity` in any units."""
+        gains = np.zeros(self.node_count)
+        inner = np.flatnonzero(self.children_left != TREE_LEAF)
+        left, right = self.children_left[inner], self.children_right[inner]
+        gains[inner] = (weight[inner] * impurity[inner] - weight[left] * impurity[left]
+                        - weight[right] * impurity[right])
+        return gains
+
     def type_importances(self, types):
         """Weighted variance reduction of the tests on each of ``types`` (sorted type ids),
         normalised to sum to 1 (all zeros for a single-leaf tree), shape (len(types),)."""
         inner = np.flatnonzero(self.children_left != TREE_LEAF)
         # in units of the root's weight and of the largest impurity (they cancel out in the
         # normalised result), so that weights and targets of any finite size stay finite
-        w = self.weighted_n_node_samples / self.weighted_n_node_samples[0]
-        imp = self.impurity / (self.impurity.max() or 1.0)
-        left, right = self.children_left[inner], self.children_right[inner]
-        decrease = w[inner] * imp[inner] - w[left] * imp[left] - w[right] * imp[right]
+        decrease = self._gains(self.weighted_n_node_samples / self.weighted_n_node_samples[0],
+                               self.impurity / (self.impurity.max() or 1.0))[inner]
         position = np.searchsorted(types, self.object_type[inner])
         total = np.bincount(position, weights=decrease, minlength=len(types))
         return total / total.sum() if total.sum() > 0 else total

@@ -9,21 +9,19 @@ plus the baselines of the thesis.
   with a ``predict`` method (`RandomPolicy`, DQN, `FQI`);
 - baselines: `make_box_forest` (thesis parameters; ``test_type="classic"``),
   `make_grid_ridge` (``GridCounts`` + ``Ridge``), `GridObservation` (a fixed-size
-  observation wrapper), `train_dqn` (stable-baselines3 DQN on it) and `SetEncoder` (a
-  stable-baselines3 features extractor for padded object sets; imported on first use, as it
-  needs torch).
+  observation wrapper, for stable-baselines3 agents) and `SetEncoder` (a stable-baselines3
+  features extractor for padded object sets; imported on first use, as it needs torch).
 
 `fqi` talks to its env through gymnasium's API only and knows no particular game.
 """
 from ._agent import FQI
-from ._baselines import DQNResult, make_box_forest, make_grid_ridge, train_dqn
+from ._baselines import make_box_forest, make_grid_ridge
 from ._evaluate import Evaluation, RandomPolicy, evaluate
 from ._logger import CSVLogger
 from ._wrappers import GridObservation
 
 __all__ = ["FQI", "evaluate", "Evaluation", "RandomPolicy", "GridObservation",
-           "make_box_forest", "make_grid_ridge", "train_dqn", "DQNResult", "CSVLogger",
-           "SetEncoder"]
+           "make_box_forest", "make_grid_ridge", "CSVLogger", "SetEncoder"]
 
 
 def __getattr__(name):

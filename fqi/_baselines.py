@@ -1,8 +1,4 @@
-"""The regressors compared in the thesis, and stable-baselines3 DQN on the grid observation."""
-import sys
-import time
-from dataclasses import dataclass
-
+"""The regressors compared in the thesis: its box forest and grid counts with a ridge."""
 import gymnasium as gym
 import numpy as np
 from sklearn.base import clone
@@ -11,25 +7,11 @@ from sklearn.pipeline import make_pipeline
 
 from boxtrees import BoxExtraTreesRegressor, GridCounts
 
-from ._checks import _check_bool, _check_int, _check_n_jobs, _check_real, _check_seed
+from ._checks import _check_int, _check_n_jobs, _check_real
 from ._envs import _spaces
-from ._evaluate import _eval_seeds, evaluate
-from ._observations import _object_bounds, _ObjectRows, _view_bounds
-from ._wrappers import GridObservation
+from ._observations import _object_bounds, _view_bounds
 
-__all__ = ["make_box_forest", "make_grid_ridge", "train_dqn", "DQNResult"]
-
-# DQN settings for 400,000 steps of an object-set game: the stable-baselines3 defaults are
-# sized for Atari (1M-step buffer, 10,000-step target updates); these follow the rl-zoo
-# settings for small discrete-action tasks (LunarLander-v2), with one gradient step per
-# 4 env steps to keep the CPU cost bounded.
-_DQN_DEFAULTS = {
-    "learning_rate": 6.3e-4, "batch_size": 128, "buffer_size": 50_000, "learning_starts": 1000,
-    "target_update_interval": 250, "train_freq": 4, "gradient_steps": 1,
-    "exploration_fraction": 0.12, "exploration_final_eps": 0.1,
-    "policy_kwargs": {"net_arch": [256, 256]},
-}
-
+__all__ = ["make_box_forest", "make_grid_ridge"]
 
 def make_box_forest(env=None, *, test_type="fixed", test_width=1.0, n_estimators=30,
                     n_tests=500, min_samples_split=30, n_jobs=-1, random_state=None,
@@ -121,116 +103,3 @@ def make_grid_ridge(env=None, *, n_bins=10, alpha=1.0, view_bounds=None, n_types
     clone(grid).fit([np.empty((0, 3))])  # its checks, now rather than at the first fit
     return make_pipeline(
         grid, Ridge(alpha=_check_real("alpha", alpha, 0.0, np.inf, high_inclusive=False)))
-
-
-class _GridModelPolicy:
-    """A model trained on `GridObservation` features, playing from object sets."""
-
-    def __init__(self, model, grid, observations):
-        self.model = model
-        self.grid = grid
-        self._observations = observations
-
-    def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        sets, single = self._observations.as_input(observation)
-        features = self.grid.transform(sets).astype(np.float32)
-        actions, _ = self.model.predict(features, deterministic=deterministic)
-        return (actions[0] if single else actions), None
-
-
-@dataclass
-class DQNResult:
-    """What `train_dqn` returns.
-
-    Attributes
-    ----------
-    model : stable_baselines3.DQN
-    policy : object
-        Plays from object sets (``policy.predict(batch)``), for `fqi.evaluate`.
-    reward : float
-        Total return of the evaluation episodes (NaN when ``eval_episodes=0``).
-    train_seconds, eval_seconds : float
-        Wall time of ``model.learn`` and of the evaluation.
-    total_timesteps : int
-    """
-
-    model: object
-    policy: object
-    reward: float
-    train_seconds: float
-    eval_seconds: float
-    total_timesteps: int
-
-
-def train_dqn(env, total_timesteps=400_000, *, n_bins=10, gamma=0.5, eval_episodes=None,
-              eval_seeds=None, seed=None, torch_threads=1, progress_bar=False, **dqn_kwargs):
-    """Train stable-baselines3 `DQN` on `GridObservation` and score it with `fqi.evaluate`.
-
-    Parameters
-    ----------
-    env : str
-        Registered id of an env observing object sets (a fresh env is made for training).
-    total_timesteps : int, default=400_000
-        Environment steps (20 FQI iterations of 20,000 samples are 400,000).
-    n_bins : int, default=10
-        Grid cells per axis of the observation.
-    gamma : float, default=0.5
-        Discount factor in ``[0, 1]`` (the FQI default, for a like-for-like comparison).
-    eval_episodes, eval_seeds
-        The evaluation after training, as `fqi.evaluate`'s `n_episodes` and `seeds`
-        (default: 10 episodes on seeds from ``2**40``); ``eval_episodes=0`` skips it.
-    seed : int >= 0 or None, default=None
-        Seeds DQN (and through it the training resets, below ``2**40``).
-    torch_threads : int, default=1
-        Torch threads while training (restored afterwards). On 2 shared cores the
-        default thread pool ran 12x slower than one thread (measured, README "fqi").
-    progress_bar : bool, default=False
-    **dqn_kwargs
-        Override the DQN settings (see ``_DQN_DEFAULTS`` in this module).
-
-    Every argument is checked before training starts.
-
-    Returns
-    -------
-    result : DQNResult
-    """
-    import torch
-    from stable_baselines3 import DQN
-    from stable_baselines3.common.logger import HumanOutputFormat, Logger
-
-    if not isinstance(env, str):
-        raise TypeError(f"env must be a registered env id, got {type(env).__name__}")
-    total_timesteps = _check_int("total_timesteps", total_timesteps, 1)
-    gamma = _check_real("gamma", gamma, 0.0, 1.0)
-    seeds = _eval_seeds(eval_episodes, eval_seeds, "eval_episodes", "eval_seeds")
-    seed = _check_seed("seed", seed)
-    torch_threads = _check_int("torch_threads", torch_threads, 1)
-    progress_bar = _check_bool("progress_bar", progress_bar)
-    reserved = sorted({"policy", "env", "gamma", "seed", "device"} & set(dqn_kwargs))
-    if reserved:
-        raise TypeError(f"train_dqn sets {reserved} itself (gamma and seed are its own "
-                        f"arguments); they cannot be DQN keywords")
-    train_env = GridObservation(gym.make(env), n_bins=n_bins)
-    try:
-        model = DQN("MlpPolicy", train_env, gamma=gamma, seed=seed, device="cpu",
-                    **{**_DQN_DEFAULTS, **dqn_kwargs})
-    except BaseException:
-        train_env.close()
-        raise
-    if model.tensorboard_log is None:
-        # SB3's own logger would create an unused /tmp/SB3-<time> folder on every call
-        model.set_logger(Logger(None, [HumanOutputFormat(sys.stdout)] if model.verbose else []))
-    threads = torch.get_num_threads()
-    torch.set_num_threads(torch_threads)
-    try:
-        start = time.perf_counter()
-        model.learn(total_timesteps=total_timesteps, progress_bar=progress_bar)
-        trained = time.perf_counter()
-    finally:
-        torch.set_num_threads(threads)
-    policy = _GridModelPolicy(model, train_env.grid,
-                              _ObjectRows(train_env.env.observation_space))
-    reward = evaluate(policy, env, seeds=seeds).total if seeds else np.nan
-    train_env.close()
-    return DQNResult(model, policy, reward, trained - start, time.perf_counter() - trained,
-                     total_timesteps)

@@ -3,7 +3,6 @@ thesis's numbers, learning, baselines, bad input. Other envs: test_fqi_envs.py."
 import csv
 import os
 import pickle
-import tempfile
 
 import gymnasium as gym
 import joblib
@@ -16,8 +15,7 @@ from sklearn.linear_model import Ridge
 
 import envs
 from boxtrees import BoxExtraTreesRegressor, ObjectSets
-from fqi import (FQI, GridObservation, RandomPolicy, evaluate, make_box_forest,
-                 make_grid_ridge, train_dqn)
+from fqi import FQI, GridObservation, RandomPolicy, evaluate, make_box_forest, make_grid_ridge
 from fqi._collect import _Collector, _Transitions
 from fqi._observations import _observation_format
 
@@ -278,16 +276,6 @@ def test_grid_observation_reuses_grid_counts():
     assert GridObservation(gym.make("ObjectWorldSword-v0")).action_space.n == 8
 
 
-def test_train_dqn_scores_with_the_same_evaluation(tmp_path, monkeypatch):
-    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
-    result = train_dqn(ENV, total_timesteps=300, eval_seeds=REFERENCE[:10], seed=0,
-                       learning_starts=100, policy_kwargs={"net_arch": [16]})
-    assert result.model.num_timesteps == 300 and result.total_timesteps == 300
-    assert np.isfinite(result.reward) and result.train_seconds > 0
-    assert result.reward == evaluate(result.policy, ENV, seeds=REFERENCE[:10]).total
-    assert not list(tmp_path.glob("SB3-*"))  # no stray SB3 log folder
-
-
 def test_scripted_policies_use_the_same_evaluation():
     greedy = evaluate(envs.GreedyPolicy(envs.BatchedObjectWorld(1)), ENV, seeds=REFERENCE)
     assert greedy.total > 100_000 and greedy.lengths.tolist() == [50] * 400
@@ -488,28 +476,6 @@ def test_regressor_without_object_sets_is_told_to_wrap_them():
         small_agent(Ridge())
     assert "a pipeline starting with boxtrees.GridCounts" in str(excinfo.value)
     assert excinfo.value.__cause__ is not None
-
-
-@pytest.mark.parametrize("kwargs, error, match", [
-    ({"eval_episodes": -1}, ValueError, "eval_episodes must be >= 0"),
-    ({"eval_seeds": [3, -1]}, ValueError, r"eval_seeds\[1\] must be >= 0"),
-    ({"total_timesteps": 0}, ValueError, "total_timesteps must be >= 1"),
-    ({"gamma": float("nan")}, ValueError, r"gamma must lie in \[0.0, 1.0\]"),
-    ({"seed": -1}, ValueError, "seed must be >= 0"),
-    ({"torch_threads": 0}, ValueError, "torch_threads must be >= 1"),
-    ({"progress_bar": 1}, TypeError, "progress_bar must be a bool"),
-    ({"device": "cuda"}, TypeError, r"train_dqn sets \['device'\] itself"),
-    ({"policy": "CnnPolicy"}, TypeError, r"train_dqn sets \['policy'\] itself"),
-])
-def test_train_dqn_checks_every_argument_before_training(monkeypatch, kwargs, error, match):
-    from stable_baselines3 import DQN
-
-    def no_training(*args, **kwargs):
-        raise AssertionError("training started")
-
-    monkeypatch.setattr(DQN, "learn", no_training)
-    with pytest.raises(error, match=match):
-        train_dqn(ENV, **kwargs)
 
 
 @pytest.mark.parametrize("make, error, match", [

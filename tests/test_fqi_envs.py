@@ -630,5 +630,4 @@ def test_fqi_imports_only_boxtrees_of_the_project():
 def test_public_names():
     assert sorted(fqi.__all__) == sorted(["FQI", "evaluate", "Evaluation", "RandomPolicy",
                                           "GridObservation", "make_box_forest",
-                                          "make_grid_ridge", "train_dqn", "DQNResult",
-                                          "CSVLogger", "SetEncoder"])
+                                          "make_grid_ridge", "CSVLogger", "SetEncoder"])

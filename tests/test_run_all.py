@@ -24,11 +24,19 @@ from benchmarks.reproduce.findings import (AtLeast, Falls, Faster, HighestPeak, 
 from benchmarks.reproduce.registry import Experiment, resolve
 from benchmarks.reproduce.report import figure_name, write_outputs
 from benchmarks.reproduce.runner import MAX_ATTEMPTS, ClusterError, cluster, gather, plan, run
-from benchmarks.reproduce.stats import SettingStats, summarise
+from benchmarks.reproduce.kinds import KINDS
+from benchmarks.reproduce.stats import SettingStats
+from benchmarks.reproduce.units import Unit
 from envs._render import _STYLE
 from fqi import FQI
 
 TINY = BUDGETS["tiny"]
+
+
+def _unit(out, experiment, label, seed=0, budget=TINY, samples=200):
+    """The unit of a registry setting (a same_as setting's own, not its owner's)."""
+    return Unit(experiment, label, seed, REGISTRY[experiment].params(label, budget), samples,
+                budget, unit_path(out, budget, experiment, label, seed))
 
 
 # ------------------------------------------------------------------------------ registry
@@ -177,7 +185,7 @@ def test_unwritable_out_is_one_error_line_and_other_errors_still_raise(tmp_path,
     assert exit_.value.code == 1
     unit, = plan([REGISTRY["attention"]], TINY, tmp_path)
     assert capsys.readouterr().err.splitlines() == [
-        f"run_all.py: error: cannot write under --out {tmp_path}: Permission denied: "
+        f"python -m benchmarks.run_all: error: cannot write under --out {tmp_path}: Permission denied: "
         f"{unit.path.parent}"]
 
     def missing(*args):
@@ -191,22 +199,22 @@ def test_unwritable_out_is_one_error_line_and_other_errors_still_raise(tmp_path,
 
 # ------------------------------------------------------------------------------ cache
 def test_cache_round_trip_and_mismatch(tmp_path):
-    params = REGISTRY["fqi_K"].params("K=50")
-    path = unit_path(tmp_path, TINY, "fqi_K", "K=50", 0)
+    unit = _unit(tmp_path, "fqi_K", "K=50")
+    path = unit.path
     assert path == tmp_path / "runs" / "tiny" / "fqi_K" / "K-50" / "seed0.json"
-    save_unit(path, params, TINY, 200, "fqi_K", "K=50", 0, _FQI_RESULT)
-    assert load_unit(path, params, TINY, 200, 0)["result"]["rewards"] == [1.0, 2.0]
+    save_unit(unit, _FQI_RESULT)
+    assert load_unit(unit)["result"]["rewards"] == [1.0, 2.0]
     assert list(path.parent.iterdir()) == [path]  # no temporary file left behind
     umask = os.umask(0)
     os.umask(umask)
     assert path.stat().st_mode & 0o777 == 0o666 & ~umask  # readable as any file, not 0600
-    assert load_unit(path, {**params, "n_tests": 51}, TINY, 200, 0) is None  # other params
-    assert load_unit(path, params, TINY, 400, 0) is None  # other samples per iteration
-    assert load_unit(path, params, replace(TINY, iterations=3), 200, 0) is None
-    assert load_unit(path, params, replace(TINY, seeds=4), 200, 0) is not None  # irrelevant
-    assert load_unit(path, params, replace(TINY, name="quick"), 200, 0) is None
+    assert load_unit(replace(unit, params={**unit.params, "n_tests": 51})) is None
+    assert load_unit(replace(unit, samples=400)) is None  # other samples per iteration
+    assert load_unit(replace(unit, budget=replace(TINY, iterations=3))) is None
+    assert load_unit(replace(unit, budget=replace(TINY, seeds=4))) is not None  # irrelevant
+    assert load_unit(replace(unit, budget=replace(TINY, name="quick"))) is None
     path.write_text("{truncated")
-    assert load_unit(path, params, TINY, 200, 0) is None
+    assert load_unit(unit) is None
     assert slug("mixed (every 5)") == "mixed_every_5"
 
 
@@ -215,10 +223,9 @@ _FQI_RESULT = {"rewards": [1.0, 2.0], "random_reward": -1.0, "seconds": 0.5}
 
 
 def _save_sampling(out, label, seed):
-    path = unit_path(out, TINY, "sampling", label, seed)
-    save_unit(path, REGISTRY["sampling"].params(label, TINY), TINY, TINY.samples, "sampling",
-              label, seed, _FQI_RESULT)
-    return path
+    unit = _unit(out, "sampling", label, seed, samples=TINY.samples)
+    save_unit(unit, _FQI_RESULT)
+    return unit.path
 
 
 def _without_seconds(path):
@@ -255,8 +262,8 @@ def test_a_cached_file_that_is_no_run_record_counts_as_missing(tmp_path, capsys,
         f"ignoring {bad}: not a run record ({problem}); it counts as missing"]
     monkeypatch.setattr(runner, "run_unit", lambda *args: dict(_FQI_RESULT))
     main(argv)
-    assert load_unit(bad, REGISTRY["sampling"].params("mixed (every 5)", TINY), TINY,
-                     TINY.samples, 0)["result"] == _FQI_RESULT  # run again
+    assert load_unit(_unit(tmp_path, "sampling", "mixed (every 5)", samples=TINY.samples))[
+        "result"] == _FQI_RESULT  # run again
     assert good.stat().st_mtime_ns == kept
 
 
@@ -312,7 +319,7 @@ def test_every_experiment_runs_end_to_end(tiny_run):
 
 
 def test_a_test_effect_is_the_right_child_minus_the_left():
-    from benchmarks.reproduce.units import _tree_tests
+    from benchmarks.reproduce.kinds.attention import tree_tests
     from boxtrees import BoxExtraTreesRegressor
 
     rng = np.random.default_rng(0)
@@ -320,7 +327,7 @@ def test_a_test_effect_is_the_right_child_minus_the_left():
     # more objects of type 0 near the origin: a higher target (they attract)
     y = [float(((np.abs(s[:, :2]).max(1) < 1) & (s[:, 2] == 0)).sum()) for s in X]
     tree = BoxExtraTreesRegressor(1, n_tests=50, min_samples_split=10, random_state=0).fit(X, y)[0].tree_
-    rows = _tree_tests(tree)
+    rows = tree_tests(tree)
     root = rows[0]
     assert root[8] == tree.value[tree.children_right[0]] - tree.value[tree.children_left[0]]
     assert root[4] == 0 and root[8] > 0
@@ -329,10 +336,10 @@ def test_a_test_effect_is_the_right_child_minus_the_left():
 def test_second_invocation_reuses_the_cache_and_resumes(tiny_run):
     out, _ = tiny_run
     units = plan([REGISTRY["representations"]], TINY, out)
-    assert run(units, TINY, progress=False) == ([], [])  # everything cached
+    assert run(units, progress=False) == ([], [])  # everything cached
     units[2].path.unlink()
     before = units[0].path.stat().st_mtime_ns
-    rerun, _ = run(units, TINY, progress=False)
+    rerun, _ = run(units, progress=False)
     assert [u.path for u, _ in rerun] == [units[2].path]
     assert units[2].path.exists() and units[0].path.stat().st_mtime_ns == before
 
@@ -350,7 +357,7 @@ def test_an_interrupted_fqi_run_resumes_from_its_last_iteration_to_the_same_resu
     uninterrupted, resumed = (plan([REGISTRY["treasure"]], budget, tmp_path / name,
                                    seeds=[0])[3] for name in ("once", "twice"))
     assert resumed.label == "global"
-    run([uninterrupted], budget, progress=False)
+    run([uninterrupted], progress=False)
     iterate = FQI._iterate
 
     def stop_at_the_third(agent):
@@ -360,27 +367,25 @@ def test_an_interrupted_fqi_run_resumes_from_its_last_iteration_to_the_same_resu
 
     monkeypatch.setattr(FQI, "_iterate", stop_at_the_third)
     with pytest.raises(KeyboardInterrupt):
-        run([resumed], budget, progress=False)
-    checkpoint = Checkpoint(resumed.path, resumed.params, budget, resumed.samples, 0,
-                            runner._environment())
+        run([resumed], progress=False)
+    checkpoint = Checkpoint(resumed, runner._environment())
     assert checkpoint.load()["agent"].iteration == 2 and attempts(resumed.path) == 0
     resumed_iterations = []
     monkeypatch.setattr(FQI, "_iterate",
                         lambda agent: resumed_iterations.append(agent.iteration)
                         or iterate(agent))
-    run([resumed], budget, progress=False)
+    run([resumed], progress=False)
     assert resumed_iterations == [2]  # only the missing iteration ran
     assert not checkpoint.path.exists()  # gone with the finished result
-    first, second = (load_unit(u.path, u.params, budget, u.samples, 0)["result"]
-                     for u in (uninterrupted, resumed))
+    first, second = (load_unit(u)["result"] for u in (uninterrupted, resumed))
     assert _without_times(second) == _without_times(first)
 
 
 def test_a_checkpoint_serves_only_its_own_unit_and_code(tmp_path, capsys):
-    params = REGISTRY["sampling"].params("normal", TINY)
-    path = unit_path(tmp_path, TINY, "sampling", "normal", 0)
+    unit = _unit(tmp_path, "sampling", "normal")
+    path = unit.path
     code = {"project sources": "abc"}
-    checkpoint = Checkpoint(path, params, TINY, 200, 0, code)
+    checkpoint = Checkpoint(unit, code)
     assert checkpoint.load() is None
     assert not checkpoint.save({"iteration": 1})  # not yet `interval` seconds
     assert not path.parent.exists()
@@ -388,25 +393,25 @@ def test_a_checkpoint_serves_only_its_own_unit_and_code(tmp_path, capsys):
     assert checkpoint.save({"iteration": 1})
     assert checkpoint.load() == {"iteration": 1}
     assert sorted(p.name for p in path.parent.iterdir()) == ["seed0.json.partial"]
-    for other in (Checkpoint(path, {**params, "n_tests": 51}, TINY, 200, 0, code),
-                  Checkpoint(path, params, TINY, 400, 0, code),
-                  Checkpoint(path, params, replace(TINY, iterations=3), 200, 0, code),
-                  Checkpoint(path, params, TINY, 200, 1, code),
-                  Checkpoint(path, params, TINY, 200, 0, {"project sources": "abd"})):
+    for other in (Checkpoint(replace(unit, params={**unit.params, "n_tests": 51}), code),
+                  Checkpoint(replace(unit, samples=400), code),
+                  Checkpoint(replace(unit, budget=replace(TINY, iterations=3)), code),
+                  Checkpoint(replace(unit, seed=1), code),
+                  Checkpoint(unit, {"project sources": "abd"})):
         assert other.load() is None
     checkpoint.path.write_bytes(b"truncated")
     assert checkpoint.load() is None
     assert f"ignoring {checkpoint.path}: not a readable checkpoint (" in capsys.readouterr().err
-    save_unit(path, params, TINY, 200, "sampling", "normal", 0, _FQI_RESULT)
+    save_unit(unit, _FQI_RESULT)
     assert not checkpoint.path.exists()
 
 
 def test_a_start_that_saved_progress_is_no_crash_and_a_failed_save_no_failure(tmp_path,
                                                                               capsys):
-    params = REGISTRY["sampling"].params("normal", TINY)
-    path = unit_path(tmp_path, TINY, "sampling", "normal", 0)
+    unit = _unit(tmp_path, "sampling", "normal")
+    path = unit.path
     mark_attempt(path)  # a start that crashed without saving anything
-    checkpoint = Checkpoint(path, params, TINY, 200, 0, {})
+    checkpoint = Checkpoint(unit, {})
     checkpoint.interval = 0.0
     mark_attempt(path)  # this start
     assert attempts(path) == 2
@@ -423,14 +428,13 @@ def test_a_start_that_saved_progress_is_no_crash_and_a_failed_save_no_failure(tm
 def test_units_run_seed_major_and_longest_first_within_a_seed(tmp_path, monkeypatch):
     order = []
 
-    def record(params, budget, seed, samples, checkpoint):
-        order.append((seed, next(u for u in units if u.params == params
-                                 and u.seed == seed).cost(budget)))
+    def record(unit, checkpoint):
+        order.append((unit.seed, unit.cost()))
         return dict(_FQI_RESULT)
 
     monkeypatch.setattr(runner, "run_unit", record)
     units = plan([REGISTRY["fqi_M"]], TINY, tmp_path, seeds=[0, 1])  # M=5, 15, 30 each
-    run(units, TINY, progress=False)
+    run(units, progress=False)
     assert [seed for seed, _ in order] == [0] * 3 + [1] * 3
     for seed in (0, 1):
         costs = [cost for s, cost in order if s == seed]
@@ -446,7 +450,7 @@ def test_units_that_crashed_run_last_and_are_skipped_after_max_attempts(tiny_run
     for _ in range(MAX_ATTEMPTS):
         mark_attempt(units[1].path)  # crashed too often: skipped
     assert attempts(units[1].path) == MAX_ATTEMPTS
-    done, skipped = run(units, TINY, progress=False)
+    done, skipped = run(units, progress=False)
     assert [u.path for u, _ in done] == [units[2].path, units[0].path]
     assert skipped == [units[1]]
     assert attempts(units[0].path) == 0 and not units[1].path.exists()
@@ -462,7 +466,7 @@ def test_a_unit_skipped_after_crashes_fails_the_command(tmp_path, capsys):
     assert exit_.value.code == 1
     err = capsys.readouterr().err
     assert f"skipping attention/bounded TW=4/seed0: it crashed {MAX_ATTEMPTS} times" in err
-    assert err.endswith(f"run_all.py: error: 1 run(s) skipped after crashing {MAX_ATTEMPTS} "
+    assert err.endswith(f"python -m benchmarks.run_all: error: 1 run(s) skipped after crashing {MAX_ATTEMPTS} "
                         f"times (listed above); the report counts them as missing\n")
     assert "| extra | [attention](#attention) | 0/1 |" in (tmp_path / "REPORT.md").read_text()
 
@@ -477,10 +481,10 @@ def test_interrupts_are_not_counted_as_crashes(tmp_path, monkeypatch):
     monkeypatch.setattr(runner, "run_unit", _interrupt)
     for _ in range(MAX_ATTEMPTS + 1):
         with pytest.raises(KeyboardInterrupt):
-            run(units, TINY, progress=False)
+            run(units, progress=False)
     assert [attempts(u.path) for u in units] == [1, 0]
     monkeypatch.setattr(runner, "run_unit", lambda *args: dict(_FQI_RESULT))
-    done, skipped = run(units, TINY, progress=False)
+    done, skipped = run(units, progress=False)
     assert [u for u, _ in done] == [units[1], units[0]] and skipped == []
 
 
@@ -491,7 +495,7 @@ def test_an_interrupted_command_says_so_in_one_line(tmp_path, capsys, monkeypatc
               "--no-progress"])
     assert exit_.value.code == 130
     assert capsys.readouterr().err.splitlines() == [
-        "run_all.py: interrupted; finished runs are cached: run the same command to resume"]
+        "python -m benchmarks.run_all: interrupted; finished runs are cached: run the same command to resume"]
     unit, = plan([REGISTRY["attention"]], TINY, tmp_path)
     assert attempts(unit.path) == 0
 
@@ -588,15 +592,16 @@ def test_other_rules():
 def test_summarise_fqi_runs():
     runs = [{"rewards": [0.0, 10.0, 20.0], "random_reward": -5.0, "seconds": 2.0},
             {"rewards": [0.0, 30.0, 40.0], "random_reward": -7.0, "seconds": 4.0}]
-    s = summarise("x", "fqi", runs)
+    s = KINDS["fqi"].summarise("x", runs)
     assert s.score == pytest.approx((10 + 70 / 3) / 2)  # mean of all 3 iterations (< 5)
     assert s.curve_mean.tolist() == [-6.0, 0.0, 20.0, 30.0]
     assert s.instability == pytest.approx(15.0) and s.best == 40.0 and s.seconds == 3.0
     assert s.mean_peak == 30.0 and s.spread == pytest.approx(20 / 3)  # sd 0, 10, 10
-    assert np.isnan(summarise("x", "fqi", runs[:1]).spread)
+    assert np.isnan(KINDS["fqi"].summarise("x", runs[:1]).spread)
     rmse = [{"fold_rmse": [1.0, 3.0], "seconds": 1.0}, {"fold_rmse": [4.0, 6.0], "seconds": 1.0}]
-    assert summarise("x", "rmse", rmse[:1]).score_se == pytest.approx(np.sqrt(2) / np.sqrt(2))
-    assert summarise("x", "rmse", rmse).score_se == pytest.approx(np.std([2, 5], ddof=1) / np.sqrt(2))
+    assert KINDS["rmse"].summarise("x", rmse[:1]).score_se == pytest.approx(1.0)
+    assert KINDS["rmse"].summarise("x", rmse).score_se == pytest.approx(
+        np.std([2, 5], ddof=1) / np.sqrt(2))
 
 
 # ------------------------------------------------------------------------------ report
@@ -605,10 +610,8 @@ def test_report_shows_thesis_numbers_beside_ours_and_computed_verdicts(tmp_path)
     budget = replace(TINY, iterations=3)
     for label, curves in {"normal": ([90e3, 10e3, 50e3], [80e3, 20e3, 50e3]),
                           "mixed (every 5)": ([50e3, 60e3, 70e3], [55e3, 65e3, 75e3])}.items():
-        params = experiment.params(label)
         for seed, curve in enumerate(curves):
-            save_unit(unit_path(tmp_path, budget, "sampling", label, seed), params, budget,
-                      budget.samples, "sampling", label, seed,
+            save_unit(_unit(tmp_path, "sampling", label, seed, budget, budget.samples),
                       {"rewards": list(curve), "random_reward": -95e3, "seconds": 60.0})
     report = write_outputs([experiment], budget, tmp_path, seeds=[0, 1])
     text = report.read_text()
@@ -641,9 +644,9 @@ def test_budget_overrides_reach_every_setting_of_their_experiment_and_its_cache(
     assert {v for (e, _), v in trees.items() if e == "sampling"} == {30}
     # a run cached without the override is not reused with it
     unit = next(u for u in units if u.experiment == "treasure")
-    save_unit(unit.path, REGISTRY["treasure"].params(unit.label), budget, unit.samples,
-              "treasure", unit.label, unit.seed, {"rewards": [0.0], "seconds": 1.0})
-    assert load_unit(unit.path, unit.params, budget, unit.samples, unit.seed) is None
+    save_unit(replace(unit, params=REGISTRY["treasure"].params(unit.label)),
+              {"rewards": [0.0], "seconds": 1.0})
+    assert load_unit(unit) is None
     report = write_outputs([REGISTRY["treasure"]], budget, tmp_path).read_text()
     assert "`treasure` runs with n_estimators=1 (every setting alike)" in report
 
@@ -684,7 +687,7 @@ def test_an_unreachable_scheduler_is_one_error_line(tmp_path, capsys):
                   "--scheduler", "tcp://127.0.0.1:1", "--no-progress"])
     assert exit_.value.code == 1
     assert capsys.readouterr().err.splitlines() == [
-        "run_all.py: error: cannot reach the Dask scheduler at tcp://127.0.0.1:1: Timed out "
+        "python -m benchmarks.run_all: error: cannot reach the Dask scheduler at tcp://127.0.0.1:1: Timed out "
         "trying to connect to tcp://127.0.0.1:1 after 1 s"]
     unit, = plan([REGISTRY["attention"]], TINY, tmp_path)
     assert attempts(unit.path) == 0
@@ -715,12 +718,12 @@ def _on_workers(client, **patches):
         client.unregister_worker_plugin("patch-runner")
 
 
-def _fake_run_unit(params, budget, seed, samples):
+def _fake_run_unit(unit):
     return dict(_FQI_RESULT)
 
 
-def _mixed_kills_its_worker(params, budget, seed, samples):
-    if params["resample_every"] == 5:
+def _mixed_kills_its_worker(unit):
+    if unit.settings.resample_every == 5:
         os._exit(1)
     return dict(_FQI_RESULT)
 
@@ -739,16 +742,15 @@ def _no_project():
 def test_a_cluster_run_is_written_here_and_resumes(dask_client, tmp_path, monkeypatch):
     units = plan([REGISTRY["sampling"]], TINY, tmp_path, seeds=[0, 1])
     written = []
-    monkeypatch.setattr(runner, "save_unit",
-                        lambda path, *args: (written.append(path), save_unit(path, *args)))
+    monkeypatch.setattr(runner, "save_unit", lambda unit, result: (
+        written.append(unit.path), save_unit(unit, result)))
     with _on_workers(dask_client, run_unit=_fake_run_unit):
-        done, skipped = run(units[:3], TINY, progress=False, client=dask_client)
+        done, skipped = run(units[:3], progress=False, client=dask_client)
         assert sorted(u.path for u, _ in done) == sorted(written) == sorted(
             u.path for u in units[:3])
-        assert all(load_unit(u.path, u.params, TINY, u.samples, u.seed)["result"] == _FQI_RESULT
-                   for u in units[:3])
+        assert all(load_unit(u)["result"] == _FQI_RESULT for u in units[:3])
         assert skipped == [] and not any(attempts(u.path) for u in units)
-        assert run(units, TINY, progress=False, client=dask_client) == (
+        assert run(units, progress=False, client=dask_client) == (
             [(units[3], _FQI_RESULT["seconds"])], [])
 
 
@@ -758,7 +760,7 @@ def test_an_interrupted_cluster_run_is_no_crash(dask_client, tmp_path, monkeypat
     monkeypatch.setattr(runner, "save_unit", _interrupt)  # Ctrl-C as the first result comes
     with _on_workers(dask_client, run_unit=_fake_run_unit):
         with pytest.raises(KeyboardInterrupt):
-            run(units, TINY, progress=False, client=dask_client)
+            run(units, progress=False, client=dask_client)
     assert [attempts(u.path) for u in units] == [1, 0, 0, 0]
 
 
@@ -777,7 +779,7 @@ def test_workers_with_other_code_are_refused(dask_client, tmp_path, environment,
                 pass
         if environment is _other_numpy:  # a worker that joined later: refused by its task
             with pytest.raises(ClusterError, match=problem):
-                run(units, TINY, progress=False, client=dask_client)
+                run(units, progress=False, client=dask_client)
     assert not any(attempts(u.path) or u.path.exists() for u in units)
 
 
@@ -785,7 +787,7 @@ def test_a_worker_that_dies_is_a_crash_of_its_unit(dask_client, tmp_path, capsys
     normal, mixed = plan([REGISTRY["sampling"]], TINY, tmp_path, seeds=[0])
     mark_attempt(mixed.path)  # crashed once before: its worker dies twice, then it is skipped
     with _on_workers(dask_client, run_unit=_mixed_kills_its_worker):
-        done, skipped = run([normal, mixed], TINY, progress=False, client=dask_client)
+        done, skipped = run([normal, mixed], progress=False, client=dask_client)
     assert [u for u, _ in done] == [normal] and skipped == [mixed]
     assert attempts(mixed.path) == MAX_ATTEMPTS and not mixed.path.exists()
     name = "sampling/mixed (every 5)/seed0"
@@ -842,6 +844,8 @@ def test_the_tuned_baselines_are_scored_once_per_fqi_iteration(name):
 def test_a_ppo_run_on_the_objects_with_attention(normalize, gamma, monkeypatch):
     import stable_baselines3
     from stable_baselines3.common import vec_env
+
+    from benchmarks import training
     from benchmarks.reproduce.units import run_unit
 
     wrapped = []
@@ -855,14 +859,15 @@ def test_a_ppo_run_on_the_objects_with_attention(normalize, gamma, monkeypatch):
             super().__init__(venv, **kwargs)
             wrapped.append((kwargs, self))
 
-    monkeypatch.setattr(vec_env, "VecNormalize", Recorded)
-    monkeypatch.setattr(stable_baselines3, "PPO", OtherDefault)
+    monkeypatch.setattr(training, "VecNormalize", Recorded)
+    monkeypatch.setitem(training.ALGORITHMS, "PPO", OtherDefault)
     params = {**REGISTRY["search_ppo_objects"].params("CartPole, gamma 0.9, attention"),
               "hyperparams": {"n_envs": 2, "n_steps": 32, "batch_size": 32, "n_epochs": 1,
                               "normalize": normalize, **({} if gamma is None else
                                                          {"gamma": gamma})},
               "step_scale": 1.0, "max_objects": 32}
-    result = run_unit(params, TINY, 0, TINY.samples)
+    result = run_unit(Unit("search_ppo_objects", "CartPole, gamma 0.9, attention", 0, params,
+                           TINY.samples, TINY, None))
     assert params["attention"] and result["total_timesteps"] >= TINY.dqn_steps
     assert len(result["curve"]) == 4 and np.isfinite(result["reward"])
     # rewards only, at the run's discount (the algorithm's default if not set); never the
@@ -881,13 +886,15 @@ def test_reference_policies_score_on_the_reference_worlds_as_learners_do():
     budget = replace(TINY, eval_steps=150)  # 3 reference worlds
     seeds = envs.reference_worlds(3)
     worlds = envs.BatchedObjectWorld(3)
-    greedy = run_unit({"kind": "policy", "env_id": "ObjectWorld-v0", "policy": "greedy"},
-                      budget, 0, TINY.samples)
+    def unit(params):
+        return Unit("ceiling", "reference", 0, {"kind": "policy", "env_id": "ObjectWorld-v0",
+                                                **params}, TINY.samples, budget, None)
+
+    greedy = run_unit(unit({"policy": "greedy"}))
     direct = evaluate(envs.GreedyPolicy(worlds), worlds, seeds=seeds)
     assert greedy["episode_returns"] == direct.returns.tolist()
     assert greedy["reward"] == direct.total * budget.reward_scale
-    planner = run_unit({"kind": "policy", "env_id": "ObjectWorld-v0", "policy": "planner",
-                        "depth": 2, "width": 2}, budget, 0, TINY.samples)
+    planner = run_unit(unit({"policy": "planner", "depth": 2, "width": 2}))
     rewards = [envs.LookaheadPlanner(depth=2, width=2).play(envs.ObjectWorldEnv(), seed=s)[1]
                for s in seeds]
     assert planner["episode_returns"] == [float(r.sum()) for r in rewards]
@@ -915,16 +922,20 @@ def test_baselines_share_their_owners_runs_and_read_against_the_ceiling(tiny_run
 
 
 def test_an_ablations_game_constants_and_ridge_penalty_reach_its_units():
-    from benchmarks.reproduce.units import _make_env, _regressor
+    from benchmarks.reproduce.kinds._game import make_env, regressor
 
-    params = REGISTRY["rmse_TW_reach"].params("TW=2.5, reach 2")
-    rules = _make_env(params).unwrapped.rules
+    def settings(experiment, label):
+        return KINDS[experiment.kind].settings(experiment.params(label))
+
+    rules = make_env(settings(REGISTRY["rmse_TW_reach"], "TW=2.5, reach 2")).unwrapped.rules
     assert (rules.contact_radius, rules.start_clearance) == (2.0, 2.0)
-    assert _make_env(REGISTRY["rmse_TW"].params("TW=2.5")).unwrapped.rules.contact_radius == 0.6
-    grid = REGISTRY["fqi_grid_alpha"].params("N=15, alpha=1000")
-    ridge = _regressor(grid, _make_env(grid), TINY, 0)
+    assert make_env(settings(REGISTRY["rmse_TW"], "TW=2.5")).unwrapped.rules.contact_radius \
+        == 0.6
+    grid = settings(REGISTRY["fqi_grid_alpha"], "N=15, alpha=1000")
+    ridge = regressor(grid, make_env(grid), TINY, 0)
     assert ridge[0].n_bins == 15 and ridge[-1].alpha == 1000.0
-    assert _regressor(REGISTRY["fqi_grid"].params("N=15"), _make_env(grid), TINY, 0)[-1].alpha == 1.0
+    other = regressor(settings(REGISTRY["fqi_grid"], "N=15"), make_env(grid), TINY, 0)
+    assert other[-1].alpha == 1.0
 
 
 def test_each_ablation_is_reported_under_why_it_differs_in_the_sections_it_explains(tiny_run):

@@ -1,5 +1,5 @@
 """Reproduce the thesis's experiments: a registry of experiments run by one runner, with
-plots and a report. Entry point: ``python benchmarks/run_all.py`` (see `reproduce.cli`)."""
+plots and a report. Entry point: ``python -m benchmarks.run_all`` (see `reproduce.cli`)."""
 from .budgets import BUDGETS, Budget
 from .registry import EXPERIMENTS, REGISTRY, Experiment
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import joblib
 
 __all__ = ["unit_path", "load_unit", "save_unit", "slug", "attempts", "mark_attempt",
-           "set_attempts", "Checkpoint"]
+           "set_attempts", "Checkpoint", "ListOf"]
 
 
 def slug(label):
@@ -48,47 +48,27 @@ def unit_path(out, budget, experiment, label, seed):
     return Path(out) / "runs" / budget.name / experiment / slug(label) / f"seed{seed}.json"
 
 
-# The budget fields each unit kind depends on (the number of seeds is not one of them).
-_BUDGET_FIELDS = {
-    "fqi": ("iterations", "eval_steps", "max_trees", "max_tests"),
-    "rmse": ("rmse_samples", "rmse_folds", "max_trees", "max_tests"),
-    "dqn": ("iterations", "eval_steps", "dqn_steps"),
-    "sb3": ("iterations", "eval_steps", "dqn_steps"),
-    "policy": ("eval_steps",),
-    "attention": ("attention_iterations", "eval_steps", "max_trees", "max_tests"),
-}
-
-
-def _record_key(params, budget, samples):
+def _record_key(unit):
     """What must match for a cached result to be reused (as JSON would give it back): the
     parameters, the samples per iteration and the budget fields the unit's kind uses."""
-    sizes = {name: getattr(budget, name) for name in _BUDGET_FIELDS[params["kind"]]}
-    return json.loads(json.dumps({"params": params,
-                                  "budget": {"name": budget.name, "samples": samples,
+    budget = unit.budget
+    sizes = {name: getattr(budget, name) for name in unit.kind.budget_fields}
+    return json.loads(json.dumps({"params": unit.params,
+                                  "budget": {"name": budget.name, "samples": unit.samples,
                                              **sizes}}))
 
 
 @dataclass(frozen=True)
-class _ListOf:
+class ListOf:
     """Shape of a JSON list: `length` items (None: any number), each of shape `item`."""
 
     item: object
     length: int = None
 
 
-def _record_shape(kind, budget):
-    """What the report reads from a record of a `kind` unit, as a shape for `_misfit`."""
-    result = {
-        "fqi": {"rewards": _ListOf(float, budget.iterations), "random_reward": float},
-        "rmse": {"fold_rmse": _ListOf(float, budget.rmse_folds)},
-        "dqn": {"reward": float},
-        "sb3": {"reward": float, "curve": _ListOf(_ListOf(float, 2))},
-        "policy": {"reward": float},
-        "attention": {"world_seed": int, "reward": float, "q_values": _ListOf(float),
-                      "actions": _ListOf({"tests": _ListOf(_ListOf(float, 9)),
-                                          "type_usage": _ListOf(float)})},
-    }[kind]
-    return {"seed": int, "result": {"seconds": float, **result}}
+def _record_shape(unit):
+    """What the report reads from a record of `unit`, as a shape for `_misfit`."""
+    return {"seed": int, "result": {"seconds": float, **unit.kind.record_shape(unit.budget)}}
 
 
 def _misfit(value, shape, where=""):
@@ -98,8 +78,9 @@ def _misfit(value, shape, where=""):
     ----------
     value : object
         Parsed JSON.
-    shape : dict, _ListOf, int or float
-        A dict: a JSON object with (at least) these keys, each of its shape; `int`: a whole
+    shape : dict, ListOf, int or float
+        A dict: a JSON object with (at least) these keys, each of its shape; `ListOf`: a
+        list; `int`: a whole
         number; `float`: any number.
     where : str
         Name of `value` in the description ("": the record).
@@ -118,7 +99,7 @@ def _misfit(value, shape, where=""):
             if problem:
                 return problem
         return None
-    if isinstance(shape, _ListOf):
+    if isinstance(shape, ListOf):
         if not isinstance(value, list) or shape.length not in (None, len(value)):
             return f"{name} is not a list" + ("" if shape.length is None
                                                else f" of {shape.length}")
@@ -143,20 +124,13 @@ def _ignore(path, problem, what="a run record"):
               file=sys.stderr)
 
 
-def load_unit(path, params, budget, samples, seed):
-    """The cached result at `path`, or None if missing, unreadable, made with other
+def load_unit(unit):
+    """The cached result of `unit`, or None if missing, unreadable, made with other
     parameters or another budget, or not a run record of this unit (said on stderr).
 
     Parameters
     ----------
-    path : path-like
-    params : dict
-        The setting's current parameters.
-    budget : Budget
-    samples : int
-        Samples per FQI iteration of this unit.
-    seed : int
-        The unit's seed.
+    unit : reproduce.units.Unit
 
     Returns
     -------
@@ -164,7 +138,7 @@ def load_unit(path, params, budget, samples, seed):
         ``{"params", "budget", "experiment", "setting", "seed", "result"}``, with every
         field the report reads.
     """
-    path = Path(path)
+    path = unit.path
     try:
         data = path.read_bytes()
     except OSError:
@@ -176,38 +150,33 @@ def load_unit(path, params, budget, samples, seed):
     else:
         problem = _misfit(record, {"params": {}, "budget": {}})
         if problem is None:
-            if {"params": record["params"], "budget": record["budget"]} \
-                    != _record_key(params, budget, samples):
+            if {"params": record["params"], "budget": record["budget"]} != _record_key(unit):
                 return None  # a record of other parameters: stale, not damaged
-            problem = _misfit(record, _record_shape(params["kind"], budget)) or (
-                None if record["seed"] == seed else f"it records seed {record['seed']}")
+            problem = _misfit(record, _record_shape(unit)) or (
+                None if record["seed"] == unit.seed else f"it records seed {record['seed']}")
     if problem is None:
         return record
     _ignore(path, problem)
     return None
 
 
-def save_unit(path, params, budget, samples, experiment, label, seed, result):
+def save_unit(unit, result):
     """Write a unit's result atomically (temporary file in the same folder, then rename),
-    so an interrupted run never leaves a half-written file that looks finished; clear its
-    attempt count.
+    so an interrupted run never leaves a half-written file that looks finished, with what
+    `load_unit` checks; clear its attempt count and its checkpoint.
 
     Parameters
     ----------
-    path : path-like
-    params, budget, samples
-        As for `load_unit`: recorded so that later loads can check them.
-    experiment, label : str
-    seed : int
+    unit : reproduce.units.Unit
     result : dict
         JSON-ready output of `reproduce.units.run_unit`.
     """
-    path = Path(path)
-    record = {"experiment": experiment, "setting": label, "seed": seed,
-              **_record_key(params, budget, samples), "result": result}
-    _write_atomically(path, lambda f: json.dump(record, f, indent=1, allow_nan=True), "w")
-    _attempts_path(path).unlink(missing_ok=True)
-    _checkpoint_path(path).unlink(missing_ok=True)
+    record = {"experiment": unit.experiment, "setting": unit.label, "seed": unit.seed,
+              **_record_key(unit), "result": result}
+    _write_atomically(unit.path, lambda f: json.dump(record, f, indent=1, allow_nan=True),
+                      "w")
+    _attempts_path(unit.path).unlink(missing_ok=True)
+    _checkpoint_path(unit.path).unlink(missing_ok=True)
 
 
 def _write_atomically(path, write, mode):
@@ -244,10 +213,7 @@ class Checkpoint:
 
     Parameters
     ----------
-    path : path-like
-        The unit's result path (`unit_path`).
-    params, budget, samples, seed
-        As for `load_unit`.
+    unit : reproduce.units.Unit
     code : dict
         What else the state depends on: library versions and a digest of the project's
         sources (`runner._environment`).
@@ -255,11 +221,11 @@ class Checkpoint:
 
     interval = 60.0
 
-    def __init__(self, path, params, budget, samples, seed, code):
-        self._result = Path(path)
-        self.path = _checkpoint_path(path)
-        self._key = {**_record_key(params, budget, samples), "seed": seed, "code": code}
-        self._attempts = attempts(path)
+    def __init__(self, unit, code):
+        self._result = unit.path
+        self.path = _checkpoint_path(unit.path)
+        self._key = {**_record_key(unit), "seed": unit.seed, "code": code}
+        self._attempts = attempts(unit.path)
         self._saved = time.monotonic()
         self._failed = False
 

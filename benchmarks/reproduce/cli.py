@@ -1,4 +1,4 @@
-"""Command line of ``benchmarks/run_all.py``."""
+"""Command line of ``python -m benchmarks.run_all``."""
 import argparse
 import os
 import time
@@ -93,7 +93,7 @@ def _out(text):
 
 def _parser():
     parser = argparse.ArgumentParser(
-        prog="run_all.py",
+        prog="python -m benchmarks.run_all",
         description="Reproduce the thesis's experiments (figures A.1-A.5, 3.1-3.6, 3.8-3.10) "
                     "and the extras (kept data, DQN, attention); write one PNG per figure, "
                     "the raw runs and REPORT.md. Finished runs are cached and skipped, so "
@@ -186,7 +186,7 @@ def main(argv=None):
 def _run(units, budget, args):
     """`run` the units here or on the cluster the arguments name."""
     with cluster(args.scheduler, args.dask_local) as client:
-        return run(units, budget, args.jobs, not args.no_progress, client)
+        return run(units, args.jobs, not args.no_progress, client)
 
 
 def _under(filename, folder):

@@ -1,6 +1,6 @@
 """Figures in the thesis's form: reward curves with a std band, RMSE bars, the DQN
 comparison, reward against environment steps for every method, and the attention figure
-(most used test boxes over a local view)."""
+(most used test boxes over a local view). Each unit kind picks its figure (`kinds`)."""
 import matplotlib
 
 matplotlib.use("Agg")
@@ -14,7 +14,8 @@ import envs  # noqa: E402
 
 from .stats import last_window  # noqa: E402
 
-__all__ = ["plot_experiment", "TYPE_NAMES", "ACTION_NAMES"]
+__all__ = ["save", "reward_curves", "rmse_bars", "reward_bars", "versus_steps", "attention",
+           "TYPE_NAMES", "ACTION_NAMES"]
 
 # The object types' colours as the renderer draws them (RGB in 0 .. 1, for matplotlib), so
 # a test box is outlined in the colour of the objects it tests in the rendered view.
@@ -26,22 +27,8 @@ ACTION_NAMES = tuple(name.replace("_", " ") for name in envs.ACTION_NAMES)
 _REFERENCE_COLOURS = ("black", "dimgrey", "darkgrey", "silver")
 
 
-def plot_experiment(experiment, stats, runs, budget, path):
-    """Draw the experiment's figure to `path` (PNG).
-
-    Parameters
-    ----------
-    experiment : Experiment
-    stats : dict of str to SettingStats
-        Settings with finished runs.
-    runs : dict of str to list of dict
-        Their raw unit records (the attention figure draws from them).
-    budget : Budget
-    path : path-like
-    """
-    draw = {"fqi": _curves, "rmse": _bars, "dqn": _dqn, "sb3": _dqn, "policy": _dqn,
-            "attention": _attention, "steps": _versus_steps}
-    fig = draw[experiment.plot or experiment.kind](experiment, stats, runs, budget)
+def save(fig, path):
+    """Write `fig` to `path` (PNG) and free it."""
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
@@ -53,7 +40,7 @@ def _title(experiment, budget, stats):
             f"{'/'.join(map(str, runs))} run(s) per setting)")
 
 
-def _curves(experiment, stats, runs, budget):
+def reward_curves(experiment, stats, budget):
     """Mean reward per iteration with a +-1 sd band over runs; iteration 0 is the random
     policy (left out for the sword game, as in the thesis: it would dwarf the curves)."""
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
@@ -74,7 +61,7 @@ def _curves(experiment, stats, runs, budget):
     return fig
 
 
-def _bars(experiment, stats, runs, budget):
+def rmse_bars(experiment, stats, runs, budget):
     """Appendix A: mean cross-validated RMSE per setting, error bars 1 sd over folds."""
     fig, ax = plt.subplots(figsize=(6, 4))
     labels = list(stats)
@@ -94,7 +81,7 @@ def _bars(experiment, stats, runs, budget):
     return fig
 
 
-def _dqn(experiment, stats, runs, budget):
+def reward_bars(experiment, stats, budget):
     """Bars: reward (mean +- sd over runs) and wall time per run of each setting (FQI in
     blue, the others: DQN, the searches' configurations, reference policies)."""
     fig, ax = plt.subplots(figsize=(6.5, 4))
@@ -113,27 +100,22 @@ def _dqn(experiment, stats, runs, budget):
     return fig
 
 
-def _versus_steps(experiment, stats, runs, budget):
-    """Reward against environment steps, mean +- 1 sd over runs: FQI after each iteration
-    (its samples per iteration apart, the random policy at 0), the baselines at their
-    checkpoints; reference policies as horizontal lines."""
+def versus_steps(experiment, stats, curves, budget):
+    """Reward against environment steps, mean +- 1 sd over runs (`curves`: label ->
+    ``(steps, mean, sd)`` of its kind's ``curve``: FQI after each iteration, the random
+    policy at 0; the baselines at their checkpoints); settings without a curve (reference
+    policies) as horizontal lines."""
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
     references = 0
     for label, s in stats.items():
-        if s.kind == "policy":
+        if curves[label] is None:
             colour = _REFERENCE_COLOURS[references % len(_REFERENCE_COLOURS)]
             references += 1
             ax.axhline(s.score, ls="--", lw=1.0, color=colour)
             ax.annotate(f"{label} ({s.score:,.0f})", (0, s.score), xytext=(2, 3),
                         textcoords="offset points", fontsize=7, color=colour)
             continue
-        if s.kind == "fqi":
-            x = np.arange(len(s.curve_mean)) * runs[label][0]["budget"]["samples"]
-            mean, sd = s.curve_mean, s.curve_sd
-        else:
-            curves = np.array([r["result"]["curve"] for r in runs[label]], dtype=float)
-            x, rewards = curves[0, :, 0], curves[:, :, 1]
-            mean, sd = rewards.mean(axis=0), rewards.std(axis=0)
+        x, mean, sd = curves[label]
         ax.plot(x, mean, marker="o", markersize=3, label=f"{label} ({s.score:,.0f}, "
                 f"{s.seconds / 60:.0f} min/run)")
         ax.fill_between(x, mean - sd, mean + sd, alpha=0.2)
@@ -149,7 +131,7 @@ def _versus_steps(experiment, stats, runs, budget):
     return fig
 
 
-def _attention(experiment, stats, runs, budget):
+def attention(experiment, runs, budget):
     """Per action, the most informative test boxes of the Q-forest on every object type
     (outline colour: the tested type; solid when more objects in the box raise Q, dashed when
     they lower it; line width: the test's weighted variance reduction) over the local view of

@@ -9,9 +9,11 @@ beside ours.
 """
 from dataclasses import dataclass, field, replace
 
-from ..zoo_hyperparams import without_gamma
+from ..zoo_hyperparams import SMALL_TASK_DQN, without_gamma
+from .budgets import BUDGETS
 from .findings import (AtLeast, Falls, Faster, HighestPeak, MoreStable, NearRandom, Ranking,
                        Sign, Similar)
+from .kinds import KINDS
 
 __all__ = ["Experiment", "EXPERIMENTS", "REGISTRY", "resolve"]
 
@@ -60,8 +62,9 @@ class Experiment:
     figure : str
         The thesis's figure ("3.6", "A.1"), or "extra".
     title : str
-    kind : {"fqi", "rmse", "dqn", "sb3", "policy", "attention"}
-        Default unit kind of the settings (a setting may set its own ``kind``).
+    kind : str
+        Default unit kind of the settings, a name of `kinds.KINDS` (a setting may set its
+        own ``kind``); each setting's parameters must be the kind's ``Settings``.
     settings : dict of str to dict
         Label -> parameters (merged over `defaults`), in plotting order.
     defaults : dict
@@ -262,12 +265,9 @@ EXPERIMENTS = (
 # local view holds at most 25 objects (20,000 random-play states; 99 % hold 20 or fewer),
 # so the set encoder's input is padded to 32 rows.
 #
-# DQN: rl-zoo3's LunarLander-v2 settings (benchmarks/zoo_hyperparams.py) with
-# learning_starts 1000 and one gradient step per 4 env steps, where rl-zoo3 has 0 and -1 (a
-# gradient step per env step). rl-zoo3 gives Acrobot-v1 the same settings, but
-# bench_control.py trains Acrobot-v1 with rl-zoo3's unchanged: these are not its Acrobot-v1
-# ones. fqi.train_dqn's defaults (`_DQN_DEFAULTS` in fqi/_baselines.py) hold the same values.
-_ZOO_DQN = {**without_gamma("LunarLander-v2"), "learning_starts": 1000, "gradient_steps": 1}
+# DQN: rl-zoo3's LunarLander-v2 settings adapted to the game (zoo_hyperparams.SMALL_TASK_DQN,
+# which the dqn experiment trains with).
+_ZOO_DQN = SMALL_TASK_DQN
 _ZOO_DQN_CARTPOLE = without_gamma("CartPole-v1")
 _ZOO_DQN_MOUNTAINCAR = without_gamma("MountainCar-v0")
 _DQN_SEARCH = {
@@ -540,6 +540,24 @@ EXPERIMENTS += (
 REGISTRY = {experiment.name: experiment for experiment in EXPERIMENTS}
 
 
+def _check_settings():
+    """Every setting's parameters, at every budget, as its kind's typed settings: a
+    misspelt or missing parameter fails on import, not hours into a run."""
+    for experiment in EXPERIMENTS:
+        for label in experiment.settings:
+            owner, owner_label = resolve(experiment, label)
+            for budget in BUDGETS.values():
+                params = owner.params(owner_label, budget)
+                where = f"{owner.name}/{owner_label} ({budget.name} budget)"
+                if params["kind"] not in KINDS:
+                    raise ValueError(f"{where}: unknown unit kind {params['kind']!r} (known: "
+                                     f"{', '.join(KINDS)})")
+                try:
+                    KINDS[params["kind"]].settings(params)
+                except ValueError as error:
+                    raise ValueError(f"{where}: {error}") from None
+
+
 def resolve(experiment, label):
     """Follow ``same_as`` links to the experiment and label that own a setting's runs.
 
@@ -561,3 +579,6 @@ def resolve(experiment, label):
         name, label = experiment.settings[label]["same_as"].split("/", 1)
         experiment = REGISTRY[name]
     return experiment, label
+
+
+_check_settings()

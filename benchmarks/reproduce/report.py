@@ -1,12 +1,12 @@
 """Outputs of a reproduction: figures, raw numbers (CSV, JSON) and REPORT.md."""
 import csv
 import json
-import math
 import time
 from pathlib import Path
 
+from . import plots
 from .budgets import EVAL_REFERENCE_STEPS
-from .plots import ACTION_NAMES, TYPE_NAMES, plot_experiment
+from .kinds import KINDS
 from .registry import EXPERIMENTS, REGISTRY
 from .runner import gather, setting_units
 from .stats import last_window
@@ -59,7 +59,7 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
     for name, (stats, runs, verdicts, done, planned) in measured.items():
         experiment = REGISTRY[name]
         if stats:
-            plot_experiment(experiment, stats, runs, budget, out / figure_name(experiment))
+            plots.save(_figure(experiment, stats, runs, budget), out / figure_name(experiment))
             _write_csv(experiment, runs, out / f"{experiment.name}.csv")
         summary[experiment.name] = _summary_entry(experiment, stats, verdicts, done, planned)
         ablations = [(REGISTRY[other], measured[other]) for other in measured
@@ -78,10 +78,13 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
     return report
 
 
-def _fmt(value, digits=0):
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "-"
-    return f"{value:,.{digits}f}"
+def _figure(experiment, stats, runs, budget):
+    """The experiment's figure: its kind's, or reward against environment steps of every
+    setting (``plot="steps"``)."""
+    if experiment.plot == "steps":
+        curves = {label: KINDS[s.kind].curve(s, runs[label]) for label, s in stats.items()}
+        return plots.versus_steps(experiment, stats, curves, budget)
+    return KINDS[experiment.kind].plot(experiment, stats, runs, budget)
 
 
 def _header(experiments, budget, seeds, elapsed, n_run):
@@ -93,7 +96,7 @@ def _header(experiments, budget, seeds, elapsed, n_run):
                 else " (fewer than the thesis: rewards rescaled)")
     return (
         f"# Reproducing the thesis: report ({budget.name} budget)\n\n"
-        f"Written by `python benchmarks/run_all.py` on {time.strftime('%Y-%m-%d %H:%M')}."
+        f"Written by `python -m benchmarks.run_all` on {time.strftime('%Y-%m-%d %H:%M')}."
         f"{timing} Finished runs are cached under `runs/{budget.name}/`; re-running the "
         f"command resumes.\n\n"
         f"Budget `{budget.name}`: {budget.seeds} run(s) per setting (fewer where an "
@@ -144,7 +147,7 @@ def _section(experiment, stats, runs, verdicts, done, planned):
     status = "" if done == planned else f" **Partial: {done} of {planned} runs finished.**"
     lines += [f"`{experiment.name}`, {done}/{planned} runs.{status}", "",
               f"![{experiment.name}]({figure_name(experiment)})", ""]
-    lines += _table(experiment, stats, runs)
+    lines += KINDS[experiment.kind].table(experiment, stats, runs)
     if verdicts:
         whose = "Claims" if experiment.figure == "extra" else "Thesis findings"
         lines += ["", f"{whose}, checked on these numbers:", ""]
@@ -187,52 +190,6 @@ def _verdict_lines(verdicts):
     return [f"- {v.claim}: **{v.mark}**. {v.explanation}" for v in verdicts]
 
 
-def _table(experiment, stats, runs):
-    """The setting table: our numbers beside the thesis's."""
-    thesis = experiment.thesis
-    if experiment.kind == "attention":
-        return _attention_table(runs)
-    if experiment.kind == "rmse":
-        lines = ["| setting | RMSE (mean over folds and actions) | sd over folds | thesis |",
-                 "| --- | --- | --- | --- |"]
-        for label, s in stats.items():
-            folds = [f for r in runs[label] for f in r["result"]["fold_rmse"]]
-            sd = (sum((f - s.score) ** 2 for f in folds) / max(len(folds) - 1, 1)) ** 0.5
-            lines.append(f"| {label} | {s.score:.2f} | {sd:.2f} | {thesis.get(label, '')} |")
-        return lines
-    ceiling = stats.get(experiment.ceiling)
-    if ceiling is not None and not ceiling.score > 0:
-        ceiling = None  # a share of nothing, or of a loss, means nothing
-    share = "" if ceiling is None else f" share of the {experiment.ceiling}'s |"
-    lines = ["| setting | runs | score +- sd over runs |" + share + " best evaluation | "
-             "mean abs. change between iterations | minutes per run | thesis |",
-             "| --- " * (7 + bool(share)) + "|"]
-    for label, s in stats.items():
-        part = "" if ceiling is None else f" {s.score / ceiling.score:.0%} |"
-        lines.append(f"| {label} | {s.n_runs} | {_fmt(s.score)} +- {_fmt(s.score_sd)} |{part} "
-                     f"{_fmt(s.best)} | {_fmt(s.instability)} | {s.seconds / 60:.1f} | "
-                     f"{thesis.get(label, '')} |")
-    randoms = [s.random_reward for s in stats.values() if not math.isnan(s.random_reward)]
-    if randoms:
-        lines.append(f"| random policy | | {_fmt(sum(randoms) / len(randoms))} |"
-                     + " |" * bool(share) + f" | | | {thesis.get('random policy', '')} |")
-    return lines
-
-
-def _attention_table(runs):
-    (label, records), = runs.items()
-    result = records[0]["result"]
-    n_types = len(result["actions"][0]["type_usage"])
-    lines = [f"Reward of the drawn Q-function: {_fmt(result['reward'])}. Share of training "
-             f"samples passing each type's tests (sample-weighted test usage), per action:", "",
-             "| action | " + " | ".join(TYPE_NAMES[t] for t in range(n_types)) + " |",
-             "| --- |" + " --- |" * n_types]
-    for action, info in enumerate(result["actions"]):
-        lines.append(f"| {ACTION_NAMES[action]} | "
-                     + " | ".join(f"{u:.0%}" for u in info["type_usage"]) + " |")
-    return lines
-
-
 def _summary_entry(experiment, stats, verdicts, done, planned):
     return {
         "figure": experiment.figure, "title": experiment.title, "runs": done,
@@ -249,19 +206,15 @@ def _summary_entry(experiment, stats, verdicts, done, planned):
 
 
 def _write_csv(experiment, runs, path):
-    """Raw per-run numbers: one row per iteration (FQI), fold (RMSE) or run (DQN)."""
+    """Raw per-run numbers: one row per value of its kind (an FQI run's iterations, an
+    RMSE study's folds, a baseline's final reward)."""
     with open(path, "w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(["experiment", "setting", "seed", "step", "value", "seconds"])
         for label, records in runs.items():
             for record in records:
                 result, seed = record["result"], record["seed"]
-                if "rewards" in result:  # fqi: step 0 is the random policy
-                    values = [result["random_reward"], *result["rewards"]]
-                elif "fold_rmse" in result:
-                    values = result["fold_rmse"]
-                else:
-                    values = [result["reward"]]
+                values = KINDS[record["params"]["kind"]].values(result)
                 for step, value in enumerate(values):
                     writer.writerow([experiment.name, label, seed, step, value,
                                      round(result["seconds"], 2)])

@@ -7,7 +7,6 @@ import platform
 import sys
 from collections import deque
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
 
 from joblib import Parallel, delayed
@@ -17,70 +16,32 @@ import boxtrees
 import envs
 import fqi
 
+from . import kinds as _kinds
 from . import units as _units
-from .budgets import EVAL_REFERENCE_STEPS
 from .cache import (Checkpoint, attempts, load_unit, mark_attempt, save_unit, set_attempts,
                     unit_path)
 from .registry import resolve
-from .stats import summarise
-from .units import run_unit
+from .units import Unit, run_unit
 
-__all__ = ["Unit", "plan", "setting_units", "run", "gather", "seeds_for", "cluster",
-           "ClusterError", "MAX_ATTEMPTS"]
+__all__ = ["plan", "setting_units", "run", "gather", "seeds_for", "cluster", "ClusterError",
+           "MAX_ATTEMPTS"]
 
 # A unit that crashed this many times is skipped (reported missing; the command fails).
 MAX_ATTEMPTS = 3
 
 
-@dataclass(frozen=True)
-class Unit:
-    """One run to do: a setting of the experiment owning it, at one seed."""
-
-    experiment: str
-    label: str
-    seed: int
-    params: dict
-    samples: int
-    path: Path
-
-    def cost(self, budget):
-        """Rough run time in seconds on 2 free cores (measured at the quick budget), for
-        the progress bar's ETA."""
-        p = self.params
-        if p["kind"] == "policy":  # the planner: about a minute per 20,000 steps (4 actions)
-            actions = 2.0 if p["env_id"] == "ObjectWorldSword-v0" else 1.0
-            return (60.0 * actions ** 2 * budget.eval_steps / EVAL_REFERENCE_STEPS
-                    if p["policy"] == "planner" else 1.0)
-        if p["kind"] in ("dqn", "sb3"):  # DQN's updates through the set encoder cost most
-            objects = 4.0 if p.get("observation") == "objects" and p.get("algo") != "PPO" \
-                else 1.0
-            return (2.5e-3 * (budget.dqn_steps or budget.iterations * self.samples)
-                    * p.get("step_scale", 1.0) * objects)
-        trees = (p["n_estimators"] / 15 * (p["n_tests"] / 300) ** 0.5
-                 if p.get("model") == "box" else 3.0)
-        if p["kind"] == "rmse":
-            return 0.1 * budget.rmse_samples / 1000 * budget.rmse_folds / 3 * trees
-        iterations = (budget.attention_iterations if p["kind"] == "attention"
-                      else budget.iterations)
-        actions = 2.0 if p["env_id"] == "ObjectWorldSword-v0" else 1.0
-        kept = 3.0 if p.get("keep_data") else 1.0
-        objects = 9.0 if p.get("view") == "global" else 1.0  # ~360 objects, not ~40
-        return 0.3 * iterations * self.samples / 1000 * trees * actions * kept * objects
-
-
 def seeds_for(experiment, budget, seeds=None):
     """Seeds of an experiment: `seeds` if given (each once), else ``range(experiment.seeds)``
     (at most the budget's seeds, so a smaller budget stays small) or ``range(budget.seeds)``;
-    unless the experiment says, the RMSE study and the attention figure use one data set /
-    forest (seed 0), as the thesis, and a reference policy's score one run. (A ``same_as``
-    setting is run, and read, with the seeds of the experiment owning it.)"""
+    unless the experiment says, a kind that runs one seed (`kinds.UnitKind.one_seed`: the
+    RMSE study and the attention figure use one data set / forest, as the thesis, and a
+    reference policy's score one run) runs seed 0. (A ``same_as`` setting is run, and read,
+    with the seeds of the experiment owning it.)"""
     if seeds is not None:
         return list(dict.fromkeys(seeds))
     if experiment.seeds is not None:
         return list(range(min(experiment.seeds, budget.seeds)))
-    one = experiment.kind in ("rmse", "attention", "policy")
-    n = 1 if one else budget.seeds
-    return list(range(n))
+    return list(range(1 if _kinds.KINDS[experiment.kind].one_seed else budget.seeds))
 
 
 def plan(experiments, budget, out, seeds=None):
@@ -117,36 +78,26 @@ def setting_units(experiment, label, budget, out, seeds=None):
     owner, owner_label = resolve(experiment, label)
     samples = int(budget.samples * owner.sample_scale)
     params = owner.params(owner_label, budget)
-    return [Unit(owner.name, owner_label, seed, params, samples,
+    return [Unit(owner.name, owner_label, seed, params, samples, budget,
                  unit_path(out, budget, owner.name, owner_label, seed))
             for seed in seeds_for(owner, budget, seeds)]
 
 
-def _execute(unit, budget):
-    checkpoint = Checkpoint(unit.path, unit.params, budget, unit.samples, unit.seed,
-                            _environment())
+def _execute(unit):
+    checkpoint = Checkpoint(unit, _environment())
     mark_attempt(unit.path)
-    result = run_unit(unit.params, budget, unit.seed, unit.samples, checkpoint)
-    _save(unit, budget, result)
+    result = run_unit(unit, checkpoint)
+    save_unit(unit, result)
     return unit, result["seconds"]
 
 
-def _save(unit, budget, result):
-    save_unit(unit.path, unit.params, budget, unit.samples, unit.experiment, unit.label,
-              unit.seed, result)
-
-
-def _name(unit):
-    return f"{unit.experiment}/{unit.label}/seed{unit.seed}"
-
-
 def _say_skipped(unit, crashes):
-    tqdm.write(f"skipping {_name(unit)}: it crashed {crashes} times (delete "
+    tqdm.write(f"skipping {unit.name}: it crashed {crashes} times (delete "
                f"{unit.path}.attempts to retry, and its .partial, if any, to start over)",
                file=sys.stderr)
 
 
-def run(units, budget, jobs=1, progress=True, client=None):
+def run(units, jobs=1, progress=True, client=None):
     """Run the units not already cached; show one progress bar with ETA over all of them.
 
     A unit's start counts as a crash until the unit finishes; an interrupt (Ctrl-C) takes
@@ -159,7 +110,6 @@ def run(units, budget, jobs=1, progress=True, client=None):
     Parameters
     ----------
     units : list of Unit
-    budget : Budget
     jobs : int, default=1
         Parallel processes (joblib loky). An FQI run's forests use every core, but its
         simulation and the neural baselines use one, so on 2 cores 2 processes finish
@@ -181,28 +131,27 @@ def run(units, budget, jobs=1, progress=True, client=None):
     ClusterError
         If a worker of `client` runs other code than this process (nothing is counted).
     """
-    crashes = {u.path: attempts(u.path) for u in units
-               if load_unit(u.path, u.params, budget, u.samples, u.seed) is None}
+    crashes = {u.path: attempts(u.path) for u in units if load_unit(u) is None}
     # Seed-major order, so an interrupted run leaves every setting with its first seeds
     # done; within a seed the longest first, so parallel processes end together; units that
     # crashed before go last, and are skipped after MAX_ATTEMPTS crashes.
     todo = sorted((u for u in units if u.path in crashes),
-                  key=lambda u: (crashes[u.path], u.seed, -u.cost(budget)))
+                  key=lambda u: (crashes[u.path], u.seed, -u.cost()))
     cached = len(units) - len(todo)
     skipped = [u for u in todo if crashes[u.path] >= MAX_ATTEMPTS]
     for u in skipped:
         _say_skipped(u, crashes[u.path])
     todo = todo[:len(todo) - len(skipped)]
     done = []
-    with tqdm(total=sum(u.cost(budget) for u in todo), disable=not progress, unit="s",
+    with tqdm(total=sum(u.cost() for u in todo), disable=not progress, unit="s",
               bar_format="{l_bar}{bar}| [{elapsed}<{remaining}]{postfix}") as bar:
         bar.set_postfix_str(f"{len(todo)} to run, {cached} cached")
-        results = _results(todo, budget, jobs, client, crashes, skipped)
+        results = _results(todo, jobs, client, crashes, skipped)
         try:
             for unit, seconds in results:
                 done.append((unit, seconds))
-                bar.update(unit.cost(budget))
-                bar.set_postfix_str(f"{_name(unit)} {seconds:.0f}s; {len(done)}/{len(todo)} "
+                bar.update(unit.cost())
+                bar.set_postfix_str(f"{unit.name} {seconds:.0f}s; {len(done)}/{len(todo)} "
                                     f"run, {cached} cached")
         except (KeyboardInterrupt, ClusterError):  # neither is a crash of the units
             results.close()  # stops the parallel workers before their counts are reset
@@ -211,15 +160,15 @@ def run(units, budget, jobs=1, progress=True, client=None):
     return done, skipped
 
 
-def _results(todo, budget, jobs, client, crashes, skipped):
+def _results(todo, jobs, client, crashes, skipped):
     """``(unit, seconds)`` of the units of `todo` as they finish: on `client`'s cluster (see
     `_ClusterRun` for `crashes` and `skipped`), else in `jobs` processes here."""
     if client is not None:
-        return _ClusterRun(client, budget, crashes, skipped).results(todo)
+        return _ClusterRun(client, crashes, skipped).results(todo)
     if jobs == 1:
-        return (_execute(u, budget) for u in todo)
+        return (_execute(u) for u in todo)
     return Parallel(n_jobs=jobs, return_as="generator_unordered")(
-        delayed(_execute)(u, budget) for u in todo)
+        delayed(_execute)(u) for u in todo)
 
 
 def _take_back(todo, done, crashes):
@@ -307,7 +256,8 @@ _RESULT_LIBRARIES = ("numpy", "scipy", "scikit-learn", "joblib", "gymnasium", "t
 
 def _describe_environment():
     """What a unit's result depends on besides its inputs: the Python and library versions
-    and a digest of the project's sources (boxtrees, envs, fqi and the units)."""
+    and a digest of the project's sources (boxtrees, envs, fqi, the units and their kinds,
+    and the training helper)."""
     environment = {"python": ".".join(platform.python_version_tuple()[:2])}
     for name in _RESULT_LIBRARIES:
         try:
@@ -315,10 +265,10 @@ def _describe_environment():
         except importlib.metadata.PackageNotFoundError:
             environment[name] = None
     digest = hashlib.sha256()
-    files = [p for package in (boxtrees, envs, fqi)
+    files = [p for package in (boxtrees, envs, fqi, _kinds)
              for p in sorted(Path(package.__file__).parent.iterdir())
              if p.suffix in (".py", ".pyx", ".pxd", ".h")]
-    for path in [*files, Path(_units.__file__)]:
+    for path in [*files, Path(_units.__file__), Path(__file__).parents[1] / "training.py"]:
         digest.update(f"{path.parent.name}/{path.name}\0".encode() + path.read_bytes())
     environment["project sources"] = digest.hexdigest()[:12]
     return environment
@@ -360,14 +310,14 @@ def _check_cluster(client):
             raise ClusterError(_mismatch(name, theirs, _environment()))
 
 
-def _run_checked(environment, params, budget, seed, samples):
+def _run_checked(environment, unit):
     """`run_unit` on a worker, if the worker has the client's `environment` (a worker that
     joined after `_check_cluster` is checked here)."""
     if _environment() != environment:
         from distributed import get_worker
         raise ClusterError(_mismatch(f"worker {get_worker().address}", _environment(),
                                      environment))
-    return run_unit(params, budget, seed, samples)
+    return run_unit(unit)
 
 
 class _ClusterRun:
@@ -377,15 +327,14 @@ class _ClusterRun:
     Parameters
     ----------
     client : distributed.Client
-    budget : Budget
     crashes : dict of Path to int
         Each unit's crash count before this run; raised for each worker that dies.
     skipped : list of Unit
         Where units that reach `MAX_ATTEMPTS` crashes are appended.
     """
 
-    def __init__(self, client, budget, crashes, skipped):
-        self.client, self.budget, self.crashes, self.skipped = client, budget, crashes, skipped
+    def __init__(self, client, crashes, skipped):
+        self.client, self.crashes, self.skipped = client, crashes, skipped
         self.environment = _environment()
         self.queue, self.running = deque(), {}
 
@@ -414,8 +363,7 @@ class _ClusterRun:
         while self.queue and len(self.running) < threads:
             unit = self.queue.popleft()
             mark_attempt(unit.path)
-            future = self.client.submit(_run_checked, self.environment, unit.params,
-                                        self.budget, unit.seed, unit.samples, pure=False)
+            future = self.client.submit(_run_checked, self.environment, unit, pure=False)
             self.running[future] = unit
             futures.append(future)
         return futures
@@ -432,13 +380,13 @@ class _ClusterRun:
             self._crashed(unit, error.allowed_failures + 1)
             return None
         result = future.result()  # raises the unit's error, with its traceback
-        _save(unit, self.budget, result)
+        save_unit(unit, result)
         return unit, result["seconds"]
 
     def _crashed(self, unit, deaths):
         count = self.crashes[unit.path] = self.crashes[unit.path] + deaths
         set_attempts(unit.path, count)
-        tqdm.write(f"{_name(unit)}: the worker running it died ({count} crash(es); "
+        tqdm.write(f"{unit.name}: the worker running it died ({count} crash(es); "
                    f"{MAX_ATTEMPTS} skip it)", file=sys.stderr)
         if count >= MAX_ATTEMPTS:
             _say_skipped(unit, count)
@@ -460,10 +408,8 @@ def gather(experiment, budget, out, seeds=None):
     stats, runs = {}, {}
     for label in experiment.settings:
         units = setting_units(experiment, label, budget, out, seeds)
-        records = [load_unit(u.path, u.params, budget, u.samples, u.seed) for u in units]
-        records = [r for r in records if r is not None]
+        records = [r for r in map(load_unit, units) if r is not None]
         if records:
             runs[label] = records
-            stats[label] = summarise(label, units[0].params["kind"],
-                                     [r["result"] for r in records])
+            stats[label] = units[0].kind.summarise(label, [r["result"] for r in records])
     return stats, runs

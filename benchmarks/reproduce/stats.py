@@ -1,9 +1,10 @@
-"""Summaries of one setting's runs: the numbers the plots, the findings and the report use."""
+"""Summaries of one setting's runs: the numbers the plots, the findings and the report use
+(each unit kind's ``summarise`` makes them, `kinds`)."""
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["SettingStats", "summarise", "LAST_WINDOW", "last_window"]
+__all__ = ["SettingStats", "LAST_WINDOW", "last_window", "sd", "se"]
 
 # A run's score: its mean reward over the last iterations (the thesis's "converges to").
 LAST_WINDOW = 5
@@ -22,7 +23,8 @@ class SettingStats:
     Attributes
     ----------
     label : str
-    kind : {"fqi", "rmse", "dqn", "sb3", "policy", "attention"}
+    kind : str
+        The unit kind of the runs (`kinds.KINDS`).
     n_runs : int
     score : float
         FQI: mean over runs of the mean reward (per 20,000 steps) of the last
@@ -71,55 +73,12 @@ class SettingStats:
     seconds: float = np.nan
 
 
-def summarise(label, kind, runs):
-    """The `SettingStats` of a setting from its unit results.
-
-    Parameters
-    ----------
-    label : str
-    kind : str
-        The unit kind that produced `runs`.
-    runs : list of dict
-        Unit results (see `reproduce.units`), at least one.
-
-    Returns
-    -------
-    stats : SettingStats
-    """
-    seconds = float(np.mean([r["seconds"] for r in runs]))
-    if kind == "fqi":
-        curves = np.array([[r["random_reward"], *r["rewards"]] for r in runs])
-        window = curves[:, 1:][:, -LAST_WINDOW:]
-        scores = window.mean(axis=1)
-        changes = np.abs(np.diff(curves[:, 1:], axis=1))
-        return SettingStats(
-            label, kind, len(runs), float(scores.mean()), _sd(scores), _se(window),
-            curve_mean=curves.mean(axis=0), curve_sd=curves.std(axis=0),
-            best=float(curves[:, 1:].max()),
-            instability=float(changes.mean()) if changes.size else np.nan,
-            mean_peak=float(curves[:, 1:].mean(axis=0).max()),
-            spread=float(curves[:, 1:].std(axis=0).mean()) if len(runs) > 1 else np.nan,
-            random_reward=float(curves[:, 0].mean()), seconds=seconds)
-    if kind == "rmse":
-        folds = np.array([r["fold_rmse"] for r in runs])
-        scores = folds.mean(axis=1)
-        # one data set: the folds' spread; several: how the score changes between data sets
-        se = _se(folds) if len(runs) == 1 else _se(scores)
-        return SettingStats(label, kind, len(runs), float(scores.mean()), _sd(scores),
-                            se, lower_is_better=True, seconds=seconds)
-    if kind in ("dqn", "sb3", "policy"):
-        rewards = np.array([r["reward"] for r in runs])
-        return SettingStats(label, kind, len(runs), float(rewards.mean()), _sd(rewards),
-                            _se(rewards), best=float(rewards.max()), seconds=seconds)
-    if kind == "attention":
-        return SettingStats(label, kind, len(runs), np.nan, np.nan, np.nan, seconds=seconds)
-    raise ValueError(f"unknown unit kind {kind!r}")
-
-
-def _sd(values):
+def sd(values):
+    """Sample standard deviation of per-run scores (0 for a single run)."""
     return float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
 
 
-def _se(values):
+def se(values):
+    """Standard error of the mean of every value of `values` (NaN for a single value)."""
     values = np.ravel(values)
     return float(np.std(values, ddof=1) / np.sqrt(len(values))) if len(values) > 1 else np.nan
