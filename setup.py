@@ -1,7 +1,11 @@
 """Build the Cython core of ``boxtrees``.
 
 Metadata lives in ``pyproject.toml``; this file only declares the extension modules.
-The default build is portable (no ``-march=native``); the inner loops are written so
+The build is portable on every platform: no ``-march`` and no ``-mavx512*`` flag. The
+AVX-512 kernels of ``boxtrees/_simd.h`` carry their own target attributes, are compiled
+only by GCC or clang targeting x86-64 outside macOS and Windows (so on Linux), and run only
+when the CPU has AVX-512F (checked at import); builds with MSVC, for macOS (either
+architecture) or for ARM have the portable kernels alone. The inner loops are written so
 that the compiler can vectorise them at the baseline instruction set.
 """
 import sys
@@ -10,6 +14,7 @@ import numpy as np
 from Cython.Build import cythonize
 from setuptools import Extension, setup
 
+# GCC and clang; MSVC keeps setuptools' own optimisation flag (/O2)
 compile_args = [] if sys.platform == "win32" else ["-O3", "-fno-math-errno"]
 
 

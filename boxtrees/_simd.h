@@ -12,6 +12,15 @@
  * run time, so the default build stays portable) sixteen objects are handled per step. Both
  * versions write exactly the same results; the AVX-512 compactions may write up to 16 slots
  * past the returned count, so `out` needs 16 spare slots.
+ *
+ * The AVX-512 versions are compiled where BOXTREES_AVX512 is defined: by GCC or clang for
+ * x86-64 Linux (and other ELF systems), through per-function target attributes (no -mavx512*
+ * flag, so the rest of the module runs on any x86-64). Elsewhere only the portable versions
+ * exist: on ARM; on Windows, where MSVC has neither the target attribute nor
+ * __builtin_cpu_supports and GCC does not align the stack for spilled 64-byte vectors; and on
+ * macOS, whose kernel turns the AVX-512 state on only at a thread's first AVX-512 instruction
+ * (so a CPUID check reports it absent) and whose compiler runtime may lack the __cpu_model
+ * that __builtin_cpu_supports reads (an import-time error in a Python module).
  */
 #ifndef BOXTREES_SIMD_H
 #define BOXTREES_SIMD_H
@@ -168,7 +177,11 @@ static int64_t boxtrees_find_leaf_portable(const boxtrees_node *nodes,
     return n - nodes;
 }
 
-#if defined(__GNUC__) && defined(__x86_64__)
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__APPLE__) && !defined(_WIN32)
+#define BOXTREES_AVX512 1
+#endif
+
+#ifdef BOXTREES_AVX512
 #include <immintrin.h>
 
 __attribute__((target("avx512f")))
@@ -274,7 +287,7 @@ static boxtrees_kernels boxtrees_select_kernels(int allow_simd)
 {
     boxtrees_kernels k = {boxtrees_compact_portable, boxtrees_compact_box_portable,
                           boxtrees_partition_portable, boxtrees_find_leaf_portable};
-#if defined(__GNUC__) && defined(__x86_64__)
+#ifdef BOXTREES_AVX512
     __builtin_cpu_init();
     if (allow_simd && __builtin_cpu_supports("avx512f")) {
         k.compact = boxtrees_compact_avx512;
