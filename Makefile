@@ -5,6 +5,11 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 SOURCES := setup.py pyproject.toml constraints.txt $(wildcard boxtrees/*.pyx boxtrees/*.pxd boxtrees/*.h)
+# torch is installed first, as the CPU build from PyTorch's index (constraints.txt pins its
+# version): stable-baselines3 would otherwise pull PyPI's CUDA build of several GB. Where that
+# index cannot be reached, pip's usual indexes give the same version (PyPI's Linux build is
+# the CUDA one, unless pip is configured with a CPU file).
+TORCH_INDEX := https://download.pytorch.org/whl/cpu
 
 .PHONY: bench test install clean
 
@@ -19,9 +24,11 @@ install: $(VENV)/.installed
 $(VENV)/.installed: $(SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -c constraints.txt torch==2.13.0
+	$(PY) -m pip install -q -c constraints.txt --index-url $(TORCH_INDEX) --retries 1 --timeout 30 torch \
+	    || { echo "torch: nothing from $(TORCH_INDEX); trying pip's usual indexes"; \
+	         $(PY) -m pip install -q -c constraints.txt torch; }
 	$(PY) -m pip install -q -c constraints.txt -e '.[dev]'
 	touch $@
 
 clean:
-	rm -rf build $(VENV) boxtrees/*.so boxtrees/*.c boxtrees/*.cpp
+	rm -rf build dist $(VENV) boxtrees/*.so boxtrees/*.c boxtrees/*.cpp
