@@ -42,7 +42,7 @@ class TunedBaselineSettings(GameSettings):
             raise ValueError(f"observation must be 'grid' or 'objects', got "
                              f"{self.observation!r}")
         if getattr(self, needs[self.observation]) is None:
-            raise ValueError(f"a {self.observation} observation needs "
+            raise ValueError(f"observation {self.observation!r} needs "
                              f"{needs[self.observation]}")
 
     def wrap(self, env):

@@ -1,0 +1,131 @@
+"""The experiment registry: every thesis figure once, settings that resolve, rules on real
+settings, budgets, and the registry settings the other benchmarks build on."""
+
+import pytest
+
+from benchmarks.reproduce import BUDGETS, EXPERIMENTS, REGISTRY
+from benchmarks.reproduce.kinds import KINDS
+from benchmarks.reproduce.registry import Experiment, resolve
+from benchmarks.reproduce.runner import plan
+
+from harness import TINY
+
+
+# ------------------------------------------------------------------------------ registry
+def test_registry_covers_every_thesis_figure_once():
+    figures = [e.figure for e in EXPERIMENTS if e.figure != "extra"]
+    assert sorted(figures) == sorted(["A.1", "A.2", "A.3", "A.4", "A.5", "3.1", "3.2", "3.3",
+                                      "3.4", "3.5", "3.6", "3.8", "3.9", "3.10"])
+    assert {e.name for e in EXPERIMENTS if e.figure == "extra" and not e.explains} == {
+        "keep_data", "dqn", "attention", "ceiling", "ceiling_sword", "baselines",
+        "search_dqn_grid", "search_dqn_objects", "search_ppo_objects"}
+    ablations = [e for e in EXPERIMENTS if e.explains]
+    assert {name for e in ablations for name in e.explains} == {
+        "rmse_K", "rmse_nmin", "rmse_TW", "rmse_grid", "fqi_grid", "representations",
+        "fqi_TW", "sampling", "sword"}
+    for ablation in ablations:
+        assert ablation.figure == "extra" and ablation.hypothesis and ablation.findings
+        assert all(REGISTRY[name].figure != "extra" for name in ablation.explains)
+    assert {e.name for e in EXPERIMENTS if e.on_demand} == {
+        "search_dqn_grid", "search_dqn_objects", "search_ppo_objects"}
+    assert len(REGISTRY) == len(EXPERIMENTS)
+
+
+def _rule_labels(rule):
+    labels = []
+    for name in ("groups", "labels", "others"):
+        value = getattr(rule, name, ())
+        labels += [x for group in value for x in group] if name == "groups" else list(value)
+    labels += [getattr(rule, name) for name in ("label", "stable", "reference")
+               if hasattr(rule, name)]
+    return labels
+
+
+@pytest.mark.parametrize("experiment", EXPERIMENTS, ids=lambda e: e.name)
+def test_every_setting_resolves_and_every_rule_names_real_settings(experiment):
+    kinds = {"fqi", "rmse", "dqn", "sb3", "policy", "attention"}
+    assert experiment.kind in kinds
+    for label in experiment.settings:
+        owner, owner_label = resolve(experiment, label)
+        params = owner.params(owner_label)
+        assert params["kind"] in kinds
+        assert params["env_id"].startswith("ObjectWorld")
+        if params["kind"] == "sb3":
+            assert {"algo", "observation", "hyperparams", "step_scale"} <= set(params)
+            assert "gamma" in params["hyperparams"]      # searched, never SB3's default
+        elif params["kind"] == "policy":
+            assert params["policy"] in ("planner", "greedy", "random")
+        elif params.get("model", "box") == "box" and params["kind"] != "dqn":
+            assert {"test_type", "n_estimators", "n_tests", "min_samples_split"} <= set(params)
+    for rule in experiment.findings:
+        assert set(_rule_labels(rule)) <= set(experiment.settings), rule
+    assert experiment.ceiling is None or experiment.ceiling in experiment.settings
+
+
+def test_thesis_axes_and_budgets():
+    assert list(REGISTRY["fqi_nmin"].settings) == ["n_min=10", "n_min=20", "n_min=30"]
+    assert list(REGISTRY["rmse_grid"].settings) == ["N=5", "N=10", "N=16", "N=21"]
+    assert REGISTRY["fqi_K"].params("K=50")["n_estimators"] == 15  # standard M
+    assert REGISTRY["representations"].params("classic")["n_tests"] == 500  # tuned K
+    assert REGISTRY["treasure"].params("global")["view"] == "global"
+    full = BUDGETS["full"]
+    assert (full.seeds, full.iterations, full.samples, full.eval_steps) == (5, 20, 20_000,
+                                                                             20_000)
+    sword = [u for u in plan([REGISTRY["sword"]], full, "out") if u.seed == 0]
+    assert {u.samples for u in sword} == {40_000}
+
+
+def test_same_as_settings_share_their_owners_units(tmp_path):
+    units = plan([REGISTRY["representations"], REGISTRY["dqn"]], BUDGETS["full"], tmp_path)
+    assert len(units) == 5 * 5 + 5  # DQN's FQI settings are the representations' runs
+    assert len({u.path for u in units}) == len(units)
+    owners = {(u.experiment, u.label) for u in plan([REGISTRY["dqn"]], TINY, tmp_path)}
+    assert ("representations", "fixed TW=1") in owners
+
+
+def test_circular_same_as_is_rejected():
+    loop = Experiment("loop", "extra", "t", "fqi", settings={"a": {"same_as": "loop/a"}})
+    REGISTRY["loop"] = loop
+    try:
+        with pytest.raises(ValueError, match="circular"):
+            resolve(loop, "a")
+    finally:
+        del REGISTRY["loop"]
+
+
+def test_bench_fqi_and_sweep_fqi_runs_are_registry_settings():
+    """The thesis-scale benchmark and the sweeps build their agents from the registry."""
+    from benchmarks import bench_fqi, sweep_fqi
+    from benchmarks.reproduce.registry import REGISTRY
+
+    for experiment, label, changes in [*bench_fqi.FQI_RUNS.values(), *sweep_fqi.REGIMES.values()]:
+        params = REGISTRY[experiment].params(label)
+        assert params["kind"] == "fqi" and set(changes) <= {"resample_every", "gamma"}
+    assert sweep_fqi._params(sweep_fqi.REGIMES["offline"], 10)["resample_every"] is None
+    assert sweep_fqi._params(sweep_fqi.REGIMES["keep"], 10)["n_estimators"] == 10
+
+
+@pytest.mark.parametrize("name", ["full", "quick"])
+def test_the_tuned_baselines_are_scored_once_per_fqi_iteration(name):
+    baselines, budget = REGISTRY["baselines"], BUDGETS[name]
+    own = [label for label, setting in baselines.settings.items() if "same_as" not in setting]
+    assert len(own) == 3
+    assert [baselines.params(label, budget)["checkpoints"] for label in own] == [
+        budget.iterations] * 3
+
+
+def test_an_ablations_game_constants_and_ridge_penalty_reach_its_units():
+    from benchmarks.reproduce.kinds._game import make_env, regressor
+
+    def settings(experiment, label):
+        return KINDS[experiment.kind].settings(experiment.params(label))
+
+    rules = make_env(settings(REGISTRY["rmse_TW_reach"], "TW=2.5, reach 2")).unwrapped.rules
+    assert (rules.contact_radius, rules.start_clearance) == (2.0, 2.0)
+    assert make_env(settings(REGISTRY["rmse_TW"], "TW=2.5")).unwrapped.rules.contact_radius \
+        == 0.6
+    grid = settings(REGISTRY["fqi_grid_alpha"], "N=15, alpha=1000")
+    ridge = regressor(grid, make_env(grid), TINY, 0)
+    assert ridge[0].n_bins == 15 and ridge[-1].alpha == 1000.0
+    other = regressor(settings(REGISTRY["fqi_grid"], "N=15"), make_env(grid), TINY, 0)
+    assert other[-1].alpha == 1.0

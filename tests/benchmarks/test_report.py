@@ -1,0 +1,136 @@
+"""Summaries, figures and REPORT.md."""
+import json
+import re
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from matplotlib.colors import to_rgb
+
+import envs
+from benchmarks.reproduce import BUDGETS, EXPERIMENTS, REGISTRY, plots, runner
+from benchmarks.reproduce.cache import load_unit, save_unit, unit_path
+from benchmarks.reproduce.cli import main
+from benchmarks.reproduce.kinds import KINDS
+from benchmarks.reproduce.registry import resolve
+from benchmarks.reproduce.report import write_outputs
+from benchmarks.reproduce.runner import gather, plan
+from envs._render import _STYLE
+
+from harness import TINY, make_unit
+
+
+def test_summarise_fqi_runs():
+    runs = [{"rewards": [0.0, 10.0, 20.0], "random_reward": -5.0, "seconds": 2.0},
+            {"rewards": [0.0, 30.0, 40.0], "random_reward": -7.0, "seconds": 4.0}]
+    s = KINDS["fqi"].summarise("x", runs)
+    assert s.score == pytest.approx((10 + 70 / 3) / 2)  # mean of all 3 iterations (< 5)
+    assert s.curve_mean.tolist() == [-6.0, 0.0, 20.0, 30.0]
+    assert s.instability == pytest.approx(15.0) and s.best == 40.0 and s.seconds == 3.0
+    assert s.mean_peak == 30.0 and s.spread == pytest.approx(20 / 3)  # sd 0, 10, 10
+    assert np.isnan(KINDS["fqi"].summarise("x", runs[:1]).spread)
+    rmse = [{"fold_rmse": [1.0, 3.0], "seconds": 1.0}, {"fold_rmse": [4.0, 6.0], "seconds": 1.0}]
+    assert KINDS["rmse"].summarise("x", rmse[:1]).score_se == pytest.approx(1.0)
+    assert KINDS["rmse"].summarise("x", rmse).score_se == pytest.approx(
+        np.std([2, 5], ddof=1) / np.sqrt(2))
+
+
+# ------------------------------------------------------------------------------ report
+def test_report_shows_thesis_numbers_beside_ours_and_computed_verdicts(tmp_path):
+    experiment = REGISTRY["sampling"]
+    budget = replace(TINY, iterations=3)
+    for label, curves in {"normal": ([90e3, 10e3, 50e3], [80e3, 20e3, 50e3]),
+                          "mixed (every 5)": ([50e3, 60e3, 70e3], [55e3, 65e3, 75e3])}.items():
+        for seed, curve in enumerate(curves):
+            save_unit(make_unit(tmp_path, "sampling", label, seed, budget, budget.samples),
+                      {"rewards": list(curve), "random_reward": -95e3, "seconds": 60.0})
+    report = write_outputs([experiment], budget, tmp_path, seeds=[0, 1])
+    text = report.read_text()
+    section = text[text.index('<a id="sampling">'):]
+    assert "| mixed (every 5) | 2 | 62,500 +- 3,536 |" in section  # mean of the 3 it.
+    assert "more stable, higher mean" in section  # the thesis's statement beside ours
+    assert "- mixed has the higher mean: **yes**" in section
+    assert "- mixed is more stable: **yes**" in section
+    assert "| 3.9 | [sampling](#sampling) | 4/4 | mixed has the higher mean | yes |" in text
+    assert (tmp_path / "fig3.9_sampling.png").exists()
+    assert "Not run at this budget yet." in text  # the other experiments
+    assert ("| 3.6 | [representations](#representations) | 0/10 | fixed ~ bounded > random box "
+            "> grid > classic | n/a | not run at this budget yet |") in text
+
+
+def test_figures_use_the_renderers_colours_and_envs_names():
+    for kind, (colour, _, _) in _STYLE.items():  # a test box: the colour of what it tests
+        assert to_rgb(plots._TYPE_COLOURS[kind]) == pytest.approx(np.array(colour) / 255)
+    assert len(plots.TYPE_NAMES) == len(envs.TYPE_NAMES)
+    assert plots.TYPE_NAMES[envs.MONEY_MARKER] == "money marker"
+    assert plots.ACTION_NAMES == ("up", "right", "down", "left", "swipe up", "swipe right",
+                                  "swipe down", "swipe left")
+
+
+def test_budget_overrides_reach_every_setting_of_their_experiment_and_its_cache(tmp_path):
+    budget = replace(TINY, overrides={"treasure": {"n_estimators": 1}})
+    units = plan([REGISTRY["treasure"], REGISTRY["sampling"]], budget, tmp_path)
+    trees = {(u.experiment, u.label): u.params["n_estimators"] for u in units}
+    assert {v for (e, _), v in trees.items() if e == "treasure"} == {1}
+    assert {v for (e, _), v in trees.items() if e == "sampling"} == {30}
+    # a run cached without the override is not reused with it
+    unit = next(u for u in units if u.experiment == "treasure")
+    save_unit(replace(unit, params=REGISTRY["treasure"].params(unit.label)),
+              {"rewards": [0.0], "seconds": 1.0})
+    assert load_unit(unit) is None
+    report = write_outputs([REGISTRY["treasure"]], budget, tmp_path).read_text()
+    assert "`treasure` runs with n_estimators=1 (every setting alike)" in report
+
+
+def test_report_marks_missing_runs_as_partial(tiny_run, tmp_path):
+    out, _ = tiny_run
+    report = main(["--budget", "tiny", "--out", str(out), "--seeds", "2",
+                   "--only", "sampling", "--report-only", "--no-progress"])
+    text = report.read_text()
+    assert "Partial: 2 of 4 runs finished" in text  # seed 1 never ran
+    assert "This invocation ran" not in text  # a report-only call runs nothing
+
+
+def test_baselines_share_their_owners_runs_and_read_against_the_ceiling(tiny_run):
+    out, _ = tiny_run
+    baselines = REGISTRY["baselines"]
+    owners = {resolve(baselines, label)[0].name for label in baselines.settings}
+    assert owners == {"representations", "keep_data", "baselines", "ceiling"}
+    # one run of each reference policy, the budget's seeds for the rest
+    assert len(runner.seeds_for(REGISTRY["ceiling"], BUDGETS["full"])) == 1
+    stats, runs = gather(baselines, TINY, out)
+    assert set(stats) == set(baselines.settings)
+    section = (out / "REPORT.md").read_text().split('<a id="baselines"></a>')[1]
+    ceiling = stats["look-ahead planner"].score
+    for label, s in stats.items():
+        assert f"| {label} | {s.n_runs} | {s.score:,.0f} +- {s.score_sd:,.0f} | " \
+               f"{s.score / ceiling:.0%} |" in section
+    fqi_run = runs["box FQI, fixed TW=1"][0]
+    assert fqi_run["result"]["rewards"] == json.loads(unit_path(
+        out, TINY, "representations", "fixed TW=1", 0).read_text())["result"]["rewards"]
+    assert (out / "extra_baselines.png").stat().st_size > 0
+
+
+def test_each_ablation_is_reported_under_why_it_differs_in_the_sections_it_explains(tiny_run):
+    out, _ = tiny_run
+    text = (out / "REPORT.md").read_text()
+    sections = dict(re.findall(r'<a id="(\w+)"></a>\n(.*?)(?=<a id=|\Z)', text, re.S))
+    summary = json.loads((out / "summary.json").read_text())["experiments"]
+    for ablation in (e for e in EXPERIMENTS if e.explains):
+        for name in ablation.explains:
+            why = sections[name].split("### Why it differs", 1)[1]
+            assert f"([{ablation.name}](#{ablation.name})," in why
+            assert ablation.hypothesis in why
+            claims = [rule.claim for rule in REGISTRY[name].findings]
+            for finding in summary[ablation.name]["findings"]:   # the computed verdicts
+                mark = {True: "yes", False: "no"}.get(finding["holds"], "n/a")
+                line = f"- {finding['claim']}: **{mark}**. {finding['explanation']}"
+                # listed where they re-check one of the section's own claims, only there
+                related = any(finding["claim"] == c or finding["claim"].endswith(f": {c}")
+                              for c in claims)
+                assert (line in why) == related, (name, line)
+            assert re.search(r"Shown( so far)?: (recovered in this ablation|undetermined|not "
+                             r"recovered)",
+                             why)
+    rep = sections["representations"].split("### Why it differs", 1)[1]
+    assert "grid + ridge reaches a positive reward: **" in rep and "10 > 15 > 21" not in rep
