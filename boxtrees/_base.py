@@ -1,5 +1,6 @@
 """What the box-test tree estimators share: parameters, growing trees, walking them, and the
 encoding of regression and classification targets."""
+import inspect
 import os
 import threading
 import warnings
@@ -13,6 +14,7 @@ from joblib import Parallel, delayed, effective_n_jobs
 from scipy.sparse import csr_matrix
 from sklearn.base import BaseEstimator, ClassifierMixin, RegressorMixin
 from sklearn.utils._param_validation import Interval, RealNotInt, StrOptions
+from sklearn.utils.class_weight import compute_class_weight, compute_sample_weight
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import _check_sample_weight, check_is_fitted
 
@@ -94,19 +96,23 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         "relative_width": ["boolean"],
     }
 
-    def _fit_trees(self, X, y, sample_weight, seeds, n_jobs=None, verbose=0, bootstrap=False):
-        """Validate the training data, set the fitted attributes and grow one tree per seed
-        (with ``bootstrap``, each on its own bootstrap sample)."""
+    def _fit_data(self, X, y, sample_weight, class_weight=None):
+        """Validate the training data, set the fitted attributes the trees share and return
+        the `_FitData` they grow on; ``class_weight`` (None, "balanced", a dict or a list of
+        dicts, as scikit-learn's) multiplies the sample weights."""
         # a feature matrix stays a matrix: its columns are indexed directly
-        sets, y = self._validate_input(X, y, reset=True, requires_y=True, matrix=True)
-        y = self._encode_targets(y)
+        sets, labels = self._validate_input(X, y, reset=True, requires_y=True, matrix=True)
+        y = self._encode_targets(labels)
         # one entry per sample, a plain NumPy array, stands in for X
         sample_weight = _check_sample_weight(
             sample_weight, np.empty(len(sets), np.int8), dtype=np.float64, ensure_non_negative=True
         )
-        keep = sample_weight > 0
-        if not keep.all():
-            sets, y, sample_weight = sets[keep], y[keep], sample_weight[keep]
+        if class_weight is not None:
+            sample_weight = sample_weight * _class_weight_factors(class_weight, labels,
+                                                                  sample_weight)
+        kept = sample_weight > 0
+        if not kept.all():
+            sets, y, sample_weight = sets[kept], y[kept], sample_weight[kept]
         if len(sets) > _INT32_MAX - 1:
             raise ValueError(f"at most {_INT32_MAX - 1} samples are supported, got {len(sets)}")
         with np.errstate(over="ignore"):
@@ -117,8 +123,6 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         # trees grow on weights and targets scaled by powers of two, exact in floating point:
         # the same trees, and no overflow in the sums of weight * target^2 whatever their units
         y_exponent, w_exponent = _scale_exponent(y), _scale_exponent(sample_weight)
-        y, sample_weight = np.ldexp(y, y_exponent), np.ldexp(sample_weight, w_exponent)
-        objects = _TrainingObjects(self, sets)
         split = self.min_samples_split
         params = _TreeParams(
             test_type=self.test_type, n_tests=self.n_tests,
@@ -126,15 +130,24 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             max_depth=-1 if self.max_depth is None else self.max_depth,
             max_retries=self.max_retries, refine_tests=bool(self.refine_tests),
         )
+        return _FitData(objects=_TrainingObjects(self, sets), y=np.ldexp(y, y_exponent),
+                        sample_weight=np.ldexp(sample_weight, w_exponent),
+                        y_exponent=y_exponent, w_exponent=w_exponent, params=params,
+                        kept=kept, labels=labels)
+
+    def _grow_trees(self, data, seeds, n_jobs=None, verbose=0, bootstrap=None):
+        """One tree per seed on the `_FitData` ``data`` (with a `_Bootstrap`, each on its own
+        bootstrap sample)."""
         trees = Parallel(n_jobs=n_jobs, verbose=verbose, prefer="threads")(
-            delayed(_grow_tree)(objects, y, sample_weight, params, int(seed), bootstrap)
+            delayed(_grow_tree)(data.objects, data.y, data.sample_weight, data.params, int(seed),
+                                bootstrap)
             for seed in seeds
         )
         for arrays in trees:     # back in the units of y and of the weights
-            arrays["value"] = np.ldexp(arrays["value"], -y_exponent)
-            arrays["impurity"] = np.ldexp(arrays["impurity"], -2 * y_exponent)
+            arrays["value"] = np.ldexp(arrays["value"], -data.y_exponent)
+            arrays["impurity"] = np.ldexp(arrays["impurity"], -2 * data.y_exponent)
             arrays["weighted_n_node_samples"] = np.ldexp(arrays["weighted_n_node_samples"],
-                                                         -w_exponent)
+                                                         -data.w_exponent)
         return [BoxTree.from_builder(self._node_arrays(arrays), self.types_, self.column_groups_,
                                      self.n_attributes_) for arrays in trees]
 
@@ -214,7 +227,11 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         return state
 
     def __setstate__(self, state):
-        super().__setstate__(state)
+        # a pickle from before a parameter existed gets the parameter's default
+        defaults = {name: parameter.default for name, parameter
+                    in inspect.signature(type(self).__init__).parameters.items()
+                    if parameter.default is not inspect.Parameter.empty}
+        super().__setstate__({**defaults, **state})
         trees = self._trees()
         if trees is not None:
             self._pack(trees)
@@ -240,13 +257,89 @@ class _TreeParams:
     refine_tests: bool
 
 
+@dataclass(frozen=True, eq=False)
+class _FitData:
+    """The training data as the trees grow on them.
+
+    ``objects`` (`_TrainingObjects`), the encoded targets ``y`` and the weights
+    ``sample_weight`` are those of the samples of positive weight (the mask ``kept`` over
+    all the samples), ``y`` and the weights scaled by ``2**y_exponent`` and
+    ``2**w_exponent``; ``labels`` are the validated targets of all the samples (the class
+    labels for a classifier).
+    """
+
+    objects: object
+    y: np.ndarray
+    sample_weight: np.ndarray
+    y_exponent: int
+    w_exponent: int
+    params: _TreeParams
+    kept: np.ndarray
+    labels: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class _Bootstrap:
+    """How each tree of a forest draws its bootstrap sample: ``n_draws`` draws with
+    replacement among the samples it is given, seeded by the tree's seed. A sample's weight
+    is multiplied by the number of times it is drawn and, with ``labels`` (the samples' class
+    labels, for ``class_weight="balanced_subsample"``), by the factor that balances the
+    classes of the draw."""
+
+    n_draws: int
+    labels: np.ndarray = None
+
+    def counts(self, seed, n):
+        """How many times each of ``n`` samples is drawn for the tree of ``seed``: the
+        draw recovers a tree's bootstrap sample from its seed."""
+        draws = np.random.default_rng([seed, 1]).integers(0, n, self.n_draws)
+        return np.bincount(draws, minlength=n)
+
+    def weights(self, seed, sample_weight):
+        """The weights of the tree of ``seed``'s bootstrap sample."""
+        weight = sample_weight * self.counts(seed, len(sample_weight))
+        if self.labels is not None:
+            weight = weight * _class_weight_factors("balanced", self.labels, weight)
+        return weight
+
+
+def _class_weight_factors(class_weight, labels, sample_weight):
+    """The factor scikit-learn's ``class_weight`` gives each sample's weight.
+
+    A dict (a list of them, one per output) gives each class its weight;
+    ``"balanced"`` gives every class of each output the same total of ``sample_weight``,
+    among the samples of positive weight (the others get 0).
+
+    Parameters
+    ----------
+    class_weight : "balanced", dict or list of dict
+    labels : ndarray of shape (n_samples,) or (n_samples, n_outputs)
+    sample_weight : ndarray of shape (n_samples,)
+
+    Returns
+    -------
+    factors : ndarray of shape (n_samples,)
+    """
+    if class_weight != "balanced":
+        return compute_sample_weight(class_weight, labels)
+    weighted = sample_weight > 0
+    columns = labels.reshape(len(labels), -1)[weighted]
+    per_output = []
+    for column in columns.T:
+        classes = np.unique(column)
+        balanced = compute_class_weight("balanced", classes=classes, y=column,
+                                        sample_weight=sample_weight[weighted])
+        per_output.append(dict(zip(classes, balanced)))
+    factors = np.zeros(len(labels))
+    factors[weighted] = compute_sample_weight(
+        per_output[0] if len(per_output) == 1 else per_output, columns)
+    return factors
+
+
 def _grow_tree(objects, y, sample_weight, params, seed, bootstrap):
-    """One tree; with ``bootstrap``, on ``n`` samples drawn with replacement (each sample's
-    weight times the number of times it is drawn), the draw seeded by the tree's seed."""
-    if bootstrap:
-        n = len(sample_weight)
-        draws = np.random.default_rng([seed, 1]).integers(0, n, n)
-        sample_weight = sample_weight * np.bincount(draws, minlength=n)
+    """One tree; with a `_Bootstrap`, on the bootstrap sample of its seed."""
+    if bootstrap is not None:
+        sample_weight = bootstrap.weights(seed, sample_weight)
     return build_tree(objects, y, sample_weight, params, seed)
 
 
@@ -361,7 +454,10 @@ class ClassificationTargets(ClassifierMixin):
         -------
         y : ndarray of shape (n_samples,) or (n_samples, n_outputs_)
         """
-        proba = self.predict_proba(X)
+        return self._most_probable(self.predict_proba(X))
+
+    def _most_probable(self, proba):
+        """The most probable class of each row of ``proba`` (as `predict_proba` gives it)."""
         if self.n_outputs_ == 1:
             return self.classes_.take(proba.argmax(axis=1))
         return np.column_stack([c.take(p.argmax(axis=1)) for c, p in zip(self.classes_, proba)])

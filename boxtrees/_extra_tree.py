@@ -86,7 +86,8 @@ class _SingleTree(BaseBoxTrees):
         -------
         self : estimator
         """
-        (self.tree_,) = trees = self._fit_trees(X, y, sample_weight, [_tree_seed(self.random_state)])
+        data = self._fit_data(X, y, sample_weight)
+        (self.tree_,) = trees = self._grow_trees(data, [_tree_seed(self.random_state)])
         self._pack(trees)
         return self
 

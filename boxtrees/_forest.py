@@ -1,17 +1,33 @@
 """Extra-Trees forests whose node tests count objects in boxes: ``BoxExtraTreesRegressor``
 and ``BoxExtraTreesClassifier``."""
+import warnings
 from numbers import Integral
 
 import numpy as np
 from sklearn.base import _fit_context
+from sklearn.metrics import r2_score
 from sklearn.utils import check_random_state
-from sklearn.utils._param_validation import Interval
+from sklearn.utils._param_validation import Interval, RealNotInt, StrOptions
 from sklearn.utils.validation import check_is_fitted
 
-from ._base import _INT32_MAX, BaseBoxTrees, ClassificationTargets, RegressionTargets
-from ._extra_tree import BoxExtraTreeClassifier, BoxExtraTreeRegressor
+from ._base import _INT32_MAX, BaseBoxTrees, ClassificationTargets, RegressionTargets, _Bootstrap
+from ._extra_tree import _SEED_MAX, BoxExtraTreeClassifier, BoxExtraTreeRegressor
 
 __all__ = ["BoxExtraTreesClassifier", "BoxExtraTreesRegressor"]
+
+# fitted attributes the trees of a fit read: a warm start's new trees must see the same
+_KEPT_BY_WARM_START = ("_fitted_on_features", "n_attributes_", "n_features_in_", "type_names_",
+                       "n_outputs_", "classes_")
+
+
+def _same(a, b):
+    """Whether two fitted attributes are equal (None, numbers, arrays or lists of arrays)."""
+    if isinstance(a, list) or isinstance(b, list):
+        return (isinstance(a, list) and isinstance(b, list) and len(a) == len(b)
+                and all(map(_same, a, b)))
+    if a is None or b is None:
+        return a is None and b is None
+    return np.array_equal(a, b)
 
 
 class _Forest(BaseBoxTrees):
@@ -21,6 +37,13 @@ class _Forest(BaseBoxTrees):
         **BaseBoxTrees._parameter_constraints,
         "n_estimators": [Interval(Integral, 1, _INT32_MAX, closed="both")],
         "bootstrap": ["boolean"],
+        "oob_score": ["boolean", callable],
+        "max_samples": [
+            None,
+            Interval(RealNotInt, 0.0, 1.0, closed="right"),
+            Interval(Integral, 1, _INT32_MAX, closed="both"),
+        ],
+        "warm_start": ["boolean"],
         "n_jobs": [Integral, None],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
@@ -41,6 +64,9 @@ class _Forest(BaseBoxTrees):
         relative_width=True,
         refine_tests=True,
         bootstrap=True,
+        oob_score=False,
+        max_samples=None,
+        warm_start=False,
         n_jobs=None,
         random_state=None,
         verbose=0,
@@ -57,13 +83,16 @@ class _Forest(BaseBoxTrees):
         self.relative_width = relative_width
         self.refine_tests = refine_tests
         self.bootstrap = bootstrap
+        self.oob_score = oob_score
+        self.max_samples = max_samples
+        self.warm_start = warm_start
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.verbose = verbose
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y, sample_weight=None):
-        """Grow the forest.
+        """Grow the forest (with ``warm_start``, only the trees it does not have yet).
 
         Parameters
         ----------
@@ -81,10 +110,34 @@ class _Forest(BaseBoxTrees):
         -------
         self : estimator
         """
-        rng = check_random_state(self.random_state)
-        seeds = rng.randint(np.iinfo(np.int64).max, size=self.n_estimators, dtype=np.int64)
-        trees = self._fit_trees(X, y, sample_weight, seeds, self.n_jobs, self.verbose,
-                                bootstrap=self.bootstrap)
+        if not self.bootstrap and self.oob_score:
+            raise ValueError("Out of bag estimation only available if bootstrap=True")
+        if not self.bootstrap and self.max_samples is not None:
+            raise ValueError(f"max_samples={self.max_samples!r} sets the size of the bootstrap "
+                             f"samples: use it with bootstrap=True, or set max_samples=None")
+        grown = self.estimators_ if self.warm_start and "estimators_" in self.__dict__ else []
+        if self.n_estimators < len(grown):
+            raise ValueError(f"n_estimators={self.n_estimators} must be larger or equal to "
+                             f"len(estimators_)={len(grown)} when warm_start==True")
+        if grown and self.n_estimators == len(grown):
+            warnings.warn("Warm-start fitting without increasing n_estimators does not fit new "
+                          "trees.", UserWarning, stacklevel=3)
+        class_weight, subsample = self._class_weight_of_fit()
+        before = dict(self.__dict__)
+        data = self._fit_data(X, y, sample_weight, class_weight)
+        if grown:
+            self._check_warm_start(before)
+        for name in [name for name in self.__dict__ if name.startswith("oob_") and
+                     name.endswith("_")]:
+            del self.__dict__[name]     # the estimates of an earlier fit
+        # each tree's seed is the one a single fit of all the trees draws for it
+        seeds = check_random_state(self.random_state).randint(
+            _SEED_MAX, size=self.n_estimators, dtype=np.int64)[len(grown):]
+        bootstrap = None
+        if self.bootstrap:
+            kept = data.labels[data.kept]
+            bootstrap = _Bootstrap(self._n_draws(len(kept)), kept if subsample else None)
+        trees = self._grow_trees(data, seeds, self.n_jobs, self.verbose, bootstrap)
         params = {name: getattr(self, name) for name in self._tree_class._get_param_names()
                   if name != "random_state"}
         # what fitting taught the forest about the data, its trees know too: every fitted
@@ -92,14 +145,83 @@ class _Forest(BaseBoxTrees):
         fitted = {name: value for name, value in self.__dict__.items()
                   if (name.endswith("_") and not name.startswith("_") and name != "estimators_")
                   or name == "_fitted_on_features"}
-        self.estimators_ = []
+        self.estimators_ = list(grown)
         for tree, seed in zip(trees, seeds):
             estimator = self._tree_class(**params, random_state=int(seed))
             estimator.__dict__.update(fitted, tree_=tree)
             estimator._pack([tree])
             self.estimators_.append(estimator)
-        self._pack(trees)
+        self._pack(self._trees())
+        if self.oob_score:
+            self._set_oob_attributes(X, data, bootstrap)
         return self
+
+    def _class_weight_of_fit(self):
+        """The ``class_weight`` that weighs the whole training set, and whether each tree
+        balances the classes of its own bootstrap sample instead (none for a regressor)."""
+        return None, False
+
+    def _n_draws(self, n):
+        """The size of each tree's bootstrap sample, of ``n`` samples of positive weight."""
+        if self.max_samples is None:
+            return n
+        if isinstance(self.max_samples, Integral):
+            return self.max_samples
+        return max(int(self.max_samples * n), 1)
+
+    def _check_warm_start(self, before):
+        """Check that the trees of the earlier fit (whose attributes were ``before``) fit the
+        data just validated: the same kind of input, attributes, outputs and classes, and
+        none of their types missing. If not, restore the earlier fit and raise a ValueError
+        naming the difference."""
+        changed = [name for name in _KEPT_BY_WARM_START
+                   if not _same(before.get(name), self.__dict__.get(name))]
+        missing = np.setdiff1d(before["types_"], self.types_)
+        if not changed and not missing.size:
+            return
+        now = dict(self.__dict__)
+        self.__dict__.clear()
+        self.__dict__.update(before)
+        if changed:
+            name = changed[0]
+            what = f"{name} is {now.get(name)!r}, was {before.get(name)!r}"
+        else:
+            what = f"the objects of types {missing.tolist()} are missing"
+        raise ValueError(f"warm_start grows new trees beside the {len(self.estimators_)} "
+                         f"fitted ones, on data of the same kind, but {what}; fit with "
+                         f"warm_start=False to start over")
+
+    def _out_of_bag_mean(self, X, data, bootstrap):
+        """Each training sample's mean leaf value over the trees whose bootstrap sample left it
+        out, shape (n_samples, n_outputs of the trees): NaN for a sample no tree left out
+        (with the warning scikit-learn's forests give). The trees' samples are drawn again
+        from their seeds."""
+        leaves = self._apply(X, self.n_jobs)
+        kept = np.flatnonzero(data.kept)
+        total = np.zeros((len(leaves), self._packed.n_outputs))
+        count = np.zeros(len(leaves))
+        for k, estimator in enumerate(self.estimators_):
+            out = np.ones(len(leaves), dtype=bool)
+            out[kept[bootstrap.counts(estimator.random_state, len(kept)) > 0]] = False
+            value = estimator.tree_.value
+            total[out] += value.reshape(len(value), -1)[leaves[out, k]]
+            count[out] += 1
+        if not count.all():
+            warnings.warn("Some inputs do not have OOB scores: no tree left them out of its "
+                          "bootstrap sample. This probably means too few trees were used to "
+                          "compute any reliable OOB estimates; their OOB predictions are NaN "
+                          "and oob_score_ leaves them out.", UserWarning, stacklevel=5)
+        with np.errstate(invalid="ignore"):
+            return total / count[:, None]
+
+    def _set_oob_attributes(self, X, data, bootstrap):
+        """Set ``oob_score_`` and the out-of-bag predictions (`_oob_predictions`)."""
+        mean = self._out_of_bag_mean(X, data, bootstrap)
+        predicted = self._oob_predictions(mean)
+        scored = ~np.isnan(mean).any(axis=1)
+        score = self.oob_score if callable(self.oob_score) else self._default_oob_score
+        self.oob_score_ = score(data.labels[scored], predicted[scored]) if scored.any() \
+            else np.nan
 
     def _trees(self):
         return [e.tree_ for e in self.estimators_] if "estimators_" in self.__dict__ else None
@@ -191,7 +313,7 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         int >= 2 is a number of samples, a float in ``(0, 1]`` a fraction of them (rounded
         up). Samples are counted whatever their weights, so scaling the weights changes
         nothing.
-    test_type : {"fixed", "bounded", "random", "classic"}, default="fixed"
+    test_type : {"fixed", "bounded", "random", "classic"}, default="random"
         How test boxes are drawn in the sampling region:
 
         - ``"fixed"``: centre uniform, half-width exactly ``test_width`` (square boxes);
@@ -199,7 +321,7 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         - ``"random"``: the four bounds uniform in the region, sorted per axis;
         - ``"classic"``: a random axis and a uniform split value; the box is the half-plane
           below it.
-    test_width : float, default=1.0
+    test_width : float, default=0.1
         Half-width (TW) for ``"fixed"`` and ``"bounded"`` tests, along each column of the box:
         in the attributes' units, or with ``relative_width`` a fraction of the sampling
         region's width along that column.
@@ -219,10 +341,10 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         attributes (a position), alone and with each other attribute, ``[(0, 1), (0, 1, 2),
         ..., (0, 1, d - 1)]`` (``[(0,)]`` for ``d = 1``); see ``docs/boxtrees.md`` for the
         measurements behind it.
-    relative_width : bool, default=False
+    relative_width : bool, default=True
         Read ``test_width`` as a fraction of the sampling region's width along each column,
         so that the boxes follow the units of every attribute.
-    refine_tests : bool, default=False
+    refine_tests : bool, default=True
         Refine the best of each node's tests on the node's training objects: each finite edge
         of its box is swept across the objects and moved to the tightest position of the best
         score, then the threshold is re-picked as the best one, for up to 3 rounds. Boxes then
@@ -231,10 +353,30 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         ``bootstrap=True``) when the sets at prediction may be larger than at training; see
         the set-size study in ``docs/set_sizes.md``. It costs a sort of the node's objects
         of the tested type per refined edge.
-    bootstrap : bool, default=False
-        Grow each tree on a bootstrap sample (``n_samples`` draws with replacement, as
-        weights), as scikit-learn's ``bootstrap``; with ``refine_tests`` it makes the refined
-        edges differ from tree to tree, so that the forest averages out their errors.
+    bootstrap : bool, default=True
+        Grow each tree on a bootstrap sample (``n_samples`` draws with replacement among the
+        samples of positive weight, as weights), as scikit-learn's ``bootstrap``; with
+        ``refine_tests`` it makes the refined edges differ from tree to tree, so that the
+        forest averages out their errors. A tree's sample is drawn from its seed (its
+        ``random_state``), and drawn again from it for the out-of-bag estimates.
+    oob_score : bool or callable, default=False
+        Score the forest on the out-of-bag samples (``oob_score_``), as scikit-learn's
+        forests do; needs ``bootstrap=True``. Each training sample is predicted by the trees
+        whose bootstrap sample left it out. True scores with the estimator's ``score``
+        metric (R^2 for the regressor, accuracy for the classifier); a callable
+        ``score(y_true, y_pred)`` scores with it. Samples no tree left out are not scored
+        (a warning says so).
+    max_samples : int or float, default=None
+        The size of each bootstrap sample, with ``bootstrap=True``: None draws as many
+        samples as there are of positive weight, an int that many, a float in ``(0, 1]``
+        that fraction of them (at least one).
+    warm_start : bool, default=False
+        Keep the fitted trees when ``fit`` is called again, and grow only the trees that
+        ``n_estimators`` adds (fewer is an error; as many fits none, with a warning). The
+        data must be of the same kind (attributes, types, outputs, classes). With the same
+        int ``random_state`` and data, the forest is the one a single fit of all the trees
+        grows. The out-of-bag estimates are computed again over all the trees, whose
+        samples are drawn again with the current ``max_samples``.
     n_jobs : int, default=None
         Number of parallel jobs for ``fit`` (over trees) and large ``predict`` / ``apply``
         calls (over samples). None means 1 unless in a ``joblib.parallel_backend`` context; -1
@@ -270,11 +412,18 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         Number of columns, when fitted on a feature matrix.
     feature_names_in_ : ndarray of str
         Column names, when fitted on a data frame with string column names.
+    oob_score_ : float
+        Score of the out-of-bag predictions, with ``oob_score``.
+    oob_prediction_ : ndarray of shape (n_samples,) or (n_samples, n_outputs)
+        Each training sample's mean prediction by the trees whose bootstrap sample left it
+        out (NaN when none did), with ``oob_score``.
 
     See Also
     --------
     BoxExtraTreeRegressor : one tree of the forest.
     GridCounts : the fixed-size grid representation, for any scikit-learn regressor.
+    type_importance, region_importance : what the objects of each type, and of each region,
+        bring to the score.
     sklearn.ensemble.ExtraTreesRegressor : classic Extra-Trees on feature matrices.
 
     Examples
@@ -304,6 +453,12 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
     """
 
     _tree_class = BoxExtraTreeRegressor
+    _default_oob_score = staticmethod(r2_score)
+
+    def _oob_predictions(self, mean):
+        """Set ``oob_prediction_`` from the out-of-bag mean leaf values; return it."""
+        self.oob_prediction_ = mean[:, 0] if self.n_outputs_ == 1 else mean
+        return self.oob_prediction_
 
 
 class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
@@ -318,8 +473,14 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
 
     Parameters
     ----------
-    n_estimators, n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, column_groups, relative_width, refine_tests, bootstrap, n_jobs, random_state, verbose
+    n_estimators, n_tests, min_samples_split, test_type, test_width, max_retries, max_depth, view_bounds, column_groups, relative_width, refine_tests, bootstrap, oob_score, max_samples, warm_start, n_jobs, random_state, verbose
         As in `BoxExtraTreesRegressor`.
+    class_weight : {"balanced", "balanced_subsample"}, dict or list of dicts, default=None
+        Weights of the classes, multiplying the sample weights, as in scikit-learn's
+        forests: a dict ``{label: weight}`` (a list of them, one per output, for several
+        outputs); ``"balanced"`` gives every class of each output the same total weight
+        over the training set, ``"balanced_subsample"`` over each tree's bootstrap sample
+        (``"balanced"`` without ``bootstrap``). None weighs every class 1.
 
     Attributes
     ----------
@@ -329,8 +490,11 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
         The class labels, in the column order of ``predict_proba``.
     n_classes_ : int or list of int
     n_outputs_ : int
-    types_, n_types_, type_names_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_
+    types_, n_types_, type_names_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_, oob_score_
         As in `BoxExtraTreesRegressor`.
+    oob_decision_function_ : ndarray of shape (n_samples, n_classes_), or a list of them per output
+        Each training sample's class probabilities by the trees whose bootstrap sample left
+        it out (NaN when none did), as `predict_proba` gives them, with ``oob_score``.
 
     Examples
     --------
@@ -351,3 +515,66 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
     """
 
     _tree_class = BoxExtraTreeClassifier
+    _parameter_constraints = {
+        **_Forest._parameter_constraints,
+        "class_weight": [StrOptions({"balanced", "balanced_subsample"}), dict, list, None],
+    }
+
+    def __init__(
+        self,
+        n_estimators=30,
+        *,
+        n_tests=500,
+        min_samples_split=30,
+        test_type="random",
+        test_width=0.1,
+        max_retries=10,
+        max_depth=None,
+        view_bounds=None,
+        column_groups=None,
+        relative_width=True,
+        refine_tests=True,
+        bootstrap=True,
+        oob_score=False,
+        max_samples=None,
+        warm_start=False,
+        class_weight=None,
+        n_jobs=None,
+        random_state=None,
+        verbose=0,
+    ):
+        super().__init__(
+            n_estimators, n_tests=n_tests, min_samples_split=min_samples_split,
+            test_type=test_type, test_width=test_width, max_retries=max_retries,
+            max_depth=max_depth, view_bounds=view_bounds, column_groups=column_groups,
+            relative_width=relative_width, refine_tests=refine_tests, bootstrap=bootstrap,
+            oob_score=oob_score, max_samples=max_samples, warm_start=warm_start, n_jobs=n_jobs,
+            random_state=random_state, verbose=verbose,
+        )
+        self.class_weight = class_weight
+
+    def _class_weight_of_fit(self):
+        preset = isinstance(self.class_weight, str)
+        if preset and self.warm_start:
+            warnings.warn(f"class_weight={self.class_weight!r} is computed from the data of each "
+                          f"fit: with warm_start, trees grown on other data weigh the classes "
+                          f"otherwise. Pass the weights of the full data as a dict (say, from "
+                          f"sklearn.utils.class_weight.compute_class_weight) instead",
+                          UserWarning, stacklevel=4)
+        if preset and self.class_weight == "balanced_subsample":
+            return (None, True) if self.bootstrap else ("balanced", False)
+        return self.class_weight, False
+
+    def _oob_predictions(self, mean):
+        """Set ``oob_decision_function_`` from the out-of-bag mean class frequencies; return
+        the most probable classes."""
+        proba = self._per_output(mean)
+        self.oob_decision_function_ = proba[0] if self.n_outputs_ == 1 else proba
+        return self._most_probable(self.oob_decision_function_)
+
+    @staticmethod
+    def _default_oob_score(y_true, y_pred):
+        """Accuracy: the share of samples whose every output is predicted right
+        (scikit-learn's ``accuracy_score`` refuses several outputs of more than 2 classes)."""
+        right = np.asarray(y_true == y_pred).reshape(len(y_true), -1)
+        return float(right.all(axis=1).mean())

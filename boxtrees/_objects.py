@@ -541,6 +541,17 @@ class ObjectSets:
         return (f"ObjectSets(n_sets={len(self)}, n_objects={self.n_objects}, "
                 f"n_attributes={self.n_attributes})")
 
+    def __array__(self, dtype=None, copy=None):
+        """Refused: a batch of sets is no array of features. scikit-learn's
+        ``permutation_importance`` converts ``X`` with NumPy, and gets this error rather than
+        one from inside NumPy."""
+        raise TypeError(
+            "ObjectSets is a batch of sets of objects, not an array of features: scikit-learn "
+            "tools that read X as a feature matrix (sklearn.inspection.permutation_importance, "
+            "partial_dependence) do not apply to it; boxtrees.type_importance and "
+            "boxtrees.region_importance measure what the objects of each type, and of each "
+            "region, bring to a score")
+
     def __getstate__(self):
         return {"data": self.data, "offsets": self.offsets, "type_names": self.type_names}
 
@@ -629,10 +640,10 @@ def _check_targets(y):
     return y
 
 
-def check_view_bounds(view_bounds, n_attributes=2):
+def check_view_bounds(view_bounds, n_attributes=2, name="view_bounds"):
     """Validate ``view_bounds`` (``(low_1, high_1, ..., low_d, high_d)``, for ``d = 2``
     ``(xmin, xmax, ymin, ymax)``, or a half-width ``r`` for ``[-r, r]^d``) and return it as a
-    float array of ``2 * n_attributes``."""
+    float array of ``2 * n_attributes``; the errors call it ``name``."""
     bounds = np.asarray(view_bounds, dtype=np.float64)
     if bounds.ndim == 0:
         bounds = np.tile([-bounds, bounds], n_attributes)
@@ -640,17 +651,17 @@ def check_view_bounds(view_bounds, n_attributes=2):
         what = "(xmin, xmax, ymin, ymax)" if n_attributes == 2 else \
             f"(low, high) of each of the {n_attributes} attributes"
         raise ValueError(
-            f"view_bounds must be {what} of finite numbers or a positive half-width; got "
+            f"{name} must be {what} of finite numbers or a positive half-width; got "
             f"{view_bounds!r}"
         )
     if np.abs(bounds).max() > _FLOAT32_MAX:
-        raise ValueError(f"view_bounds must fit in float32 (|value| <= 3.4e38); got {view_bounds!r}")
+        raise ValueError(f"{name} must fit in float32 (|value| <= 3.4e38); got {view_bounds!r}")
     if (bounds[0::2] >= bounds[1::2]).any():
-        raise ValueError(f"view_bounds needs each low below its high (xmin < xmax, ymin < ymax); "
+        raise ValueError(f"{name} needs each low below its high (xmin < xmax, ymin < ymax); "
                          f"got {view_bounds!r}")
     single = bounds.astype(np.float32)
     if (single[0::2] >= single[1::2]).any():
-        raise ValueError(f"view_bounds collapses to an empty region in float32; got {view_bounds!r}")
+        raise ValueError(f"{name} collapses to an empty region in float32; got {view_bounds!r}")
     return bounds
 
 
@@ -687,6 +698,9 @@ class ObjectInputMixin:
         matrix is returned as the validated float32 matrix instead of as object sets."""
         from sklearn.utils.validation import check_array, validate_data
 
+        if requires_y and issparse(y):
+            raise TypeError(f"sparse targets are not supported: y is a {type(y).__name__}; "
+                            f"pass a dense array (y.toarray())")
         dense = is_feature_matrix(X)
         if not reset:
             fitted_dense = self._fitted_on_features
