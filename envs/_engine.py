@@ -1,14 +1,17 @@
 """The vectorised ObjectWorld engine: the game's rules, written once for many worlds.
 
 `ObjectWorldEnv` is this engine over one world and `BatchedObjectWorld` over many, so the
-two cannot disagree. All worlds advance in lockstep. Each world draws from its own generator
-only, so the transitions of a world never depend on how many worlds run beside it.
+two cannot disagree. All worlds step together, each at its own step of its episode (a world
+reset alone, `_Engine.replaced`, starts again while the others go on). Each world draws from
+its own generator only, so the transitions of a world never depend on how many worlds run
+beside it.
 
 Stream. A world's generator gives, at reset, one block of uniforms: the layout, then the move
 noise of the whole episode (two per step); then the redraws of objects too close to the start,
 and after them the next episode. The noise is read in chunks of `_NOISE_CHUNK` steps: reset
 draws the first chunk with the layout, keeps the generator state where the second one starts
-and skips the stream past the episode's noise; a later chunk is drawn from that kept state.
+and skips the stream past the episode's noise; a later chunk is drawn, world by world, from
+that kept state.
 The draws are those of taking the whole block at once, in memory that does not grow with
 ``max_steps``.
 
@@ -128,7 +131,7 @@ def _ragged_concat(n_worlds, parts):
 
 
 class _Engine:
-    """The rules of `n_worlds` ObjectWorlds, stepped in lockstep with numpy.
+    """The rules of `n_worlds` ObjectWorlds, stepped together with numpy.
 
     Parameters
     ----------
@@ -137,8 +140,8 @@ class _Engine:
 
     Attributes
     ----------
-    t : int
-        Steps taken since the last reset.
+    t : ndarray of intp of shape (n_worlds,)
+        Steps each world has taken since it was reset.
     observation : tuple of (ndarray, ndarray)
         The current observations as rows ``[dx, dy, type]`` (float32, world after world) and
         offsets: world ``i`` sees ``data[offsets[i]:offsets[i + 1]]``.
@@ -164,7 +167,7 @@ class _Engine:
         # Only objects this close (per coordinate) to the agent can lie on its path.
         self._path_reach = rules.contact_radius + 1 + rules.move_noise
         self._minimap = math.ceil(size_w / rules.view_size)  # minimap cells are view-sized
-        self.t = 0
+        self.t = np.zeros(n_worlds, dtype=np.intp)
         self.observation = None
 
     # ----------------------------------------------------------------------------------
@@ -231,13 +234,13 @@ class _Engine:
                 [radius * np.cos(angle), radius * np.sin(angle)], axis=2)
             used += 2 + 2 * rules.n_treasure
         self._noise = rules.move_noise * (2 * u[:, used:].reshape(n, first, 2) - 1)
-        self._noise_start = 0  # the step of self._noise[:, 0]
+        self._noise_start = np.zeros(n, dtype=np.intp)  # each world's step of its _noise[i, 0]
 
         self._ex = enemies[..., 0].copy()
         self._ey = enemies[..., 1].copy()
         self._enemy_alive = np.ones(self._ex.shape, dtype=bool)
         self.agent = np.zeros((n, 2))
-        self.t = 0
+        self.t = np.zeros(n, dtype=np.intp)
 
         # Static objects, sorted world by world and then by grid cell.
         statics = np.concatenate([np.broadcast_to(self._border, (n,) + self._border.shape),
@@ -276,21 +279,23 @@ class _Engine:
         Parameters
         ----------
         actions : ndarray of int of shape (n_worlds,)
-            Valid action ids (checked by the caller).
+            Valid action ids (checked by the caller), for worlds that have not reached
+            ``max_steps``.
 
         Returns
         -------
         rewards : ndarray of float64 of shape (n_worlds,)
-        truncated : bool
-            Whether the episodes (all in lockstep) reached ``max_steps``.
+        truncated : ndarray of bool of shape (n_worlds,)
+            Whether each world's episode reached ``max_steps``.
         """
         rules, n = self.rules, self.n_worlds
         radius = rules.contact_radius
-        if self.t == self._noise_start + self._noise.shape[1]:
-            self._draw_noise()
+        stale = np.flatnonzero(self.t - self._noise_start == self._noise.shape[1])
+        if len(stale):
+            self._draw_noise(stale)
         moves = actions < 4
         direction = _DIRECTIONS[actions & 3]
-        noise = self._noise[:, self.t - self._noise_start]
+        noise = self._noise[np.arange(n), self.t - self._noise_start]
         delta = np.where(moves[:, None], direction + noise, 0.0)
         dx, dy = delta[:, 0], delta[:, 1]
         ax, ay = self.agent[:, 0], self.agent[:, 1]
@@ -368,51 +373,53 @@ class _Engine:
         _Engine
         """
         worlds = np.asarray(worlds, dtype=np.intp)
-        n, k, s = self.n_worlds, len(worlds), self._n_static
-        new = copy.copy(self)  # the rules and what only depends on them are shared
-        new.n_worlds = k
-        names = ["_x", "_y", "_types", "_alive"]
-        names += ["_minimap_cell"] if self.rules.view == "minimap" else []
-        for name in names:  # flat, world after world
-            setattr(new, name, getattr(self, name).reshape(n, s)[worlds].ravel())
-        n_cells = self._grid ** 2
-        own_start = self._cell_start[:-1].reshape(n, n_cells) - s * np.arange(n)[:, None]
-        new._cell_start = np.append((own_start[worlds] + s * np.arange(k)[:, None]).ravel(),
-                                    k * s)
-        names = ["_ex", "_ey", "_enemy_alive", "agent", "_treasure", "_noise"]
-        names += ["_cell_money", "_visited"] if self.rules.view == "minimap" else []
-        for name in names:  # one row per world
-            setattr(new, name, getattr(self, name)[worlds])
-        new._rngs = [self._rngs[i] for i in worlds]
-        if self._noise_states is not None:  # _draw_noise replaces these dicts, never edits them
-            new._noise_states = [self._noise_states[i] for i in worlds]
-        data, offsets = self.observation
-        sizes = np.diff(offsets)[worlds]
-        new_offsets = np.zeros(k + 1, dtype=np.intp)
-        np.cumsum(sizes, out=new_offsets[1:])
-        rows = np.repeat(offsets[worlds] - new_offsets[:-1], sizes) + np.arange(new_offsets[-1])
-        new.observation = (data[rows], new_offsets)
-        return new
+        return _gather([self], np.zeros(len(worlds), dtype=np.intp), worlds)
+
+    def replaced(self, worlds, other):
+        """A new engine: this one with world ``worlds[j]`` replaced by world ``j`` of `other`.
+
+        Every world is copied as by `take`, with its step count, so a world reset on its own
+        (`other` freshly reset) starts its episode while the others go on with theirs.
+
+        Parameters
+        ----------
+        worlds : ndarray of int of shape (k,)
+            Distinct worlds of this engine (valid ids, checked by the caller).
+        other : _Engine
+            An engine of ``k`` worlds of the same rules, whose worlds hold as many objects of
+            each type as this engine's (checked by the caller).
+
+        Returns
+        -------
+        _Engine
+        """
+        source = np.zeros(self.n_worlds, dtype=np.intp)
+        index = np.arange(self.n_worlds)
+        source[worlds] = 1
+        index[worlds] = np.arange(len(worlds))
+        return _gather([self, other], source, index)
 
     # ----------------------------------------------------------------------------------
-    def _draw_noise(self):
-        """Draw the move noise of the next `_NOISE_CHUNK` steps where each stream keeps it.
+    def _draw_noise(self, worlds):
+        """Draw the move noise of the next `_NOISE_CHUNK` steps of `worlds` where each
+        stream keeps it.
 
         Each generator is set to the kept state, draws, and is put back where it was, so its
-        own position (the next episode's start) does not move.
+        own position (the next episode's start) does not move. A world's last chunk may be
+        shorter than ``_noise.shape[1]``; the rest of its row is never read.
         """
         rules = self.rules
-        count = min(_NOISE_CHUNK, rules.max_steps - self.t)
-        u = np.empty((self.n_worlds, 2 * count))
-        for i, rng in enumerate(self._rngs):
+        for i in worlds:
+            count = min(_NOISE_CHUNK, rules.max_steps - self.t[i])
+            rng = self._rngs[i]
             bit_generator = rng.bit_generator
             position = bit_generator.state
             bit_generator.state = self._noise_states[i]
-            u[i] = rng.random(2 * count)
+            u = rng.random(2 * count)
             self._noise_states[i] = bit_generator.state
             bit_generator.state = position
-        self._noise = rules.move_noise * (2 * u.reshape(self.n_worlds, count, 2) - 1)
-        self._noise_start = self.t
+            self._noise[i, :count] = rules.move_noise * (2 * u.reshape(count, 2) - 1)
+        self._noise_start[worlds] = self.t[worlds]
 
     def _swipe(self, swiping, direction, erx, ery):
         """Rewards of the swipes; a swipe that hits exactly one enemy kills it."""
@@ -537,3 +544,51 @@ class _Engine:
             mine = world == i
             rows.append(np.column_stack([xy[mine], np.broadcast_to(types, world.shape)[mine]]))
         return np.concatenate(rows)
+
+
+def _joined(parts):
+    """`parts` concatenated along their first axis (the only part itself, not copied)."""
+    return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+
+def _gather(engines, source, worlds):
+    """A new engine whose world ``j`` is a copy of world ``worlds[j]`` of
+    ``engines[source[j]]``, mid-episode (see `_Engine.take`).
+
+    The engines have the same rules and their worlds as many objects of each type; what only
+    depends on the rules is shared with the first engine.
+    """
+    first = engines[0]
+    s, n_cells = first._n_static, first._grid ** 2
+    index = np.cumsum([0] + [engine.n_worlds for engine in engines])[source] + worlds
+    k = len(index)  # index: into the worlds of all the engines, engine after engine
+    new = copy.copy(first)
+    new.n_worlds = k
+    names = ["_x", "_y", "_types", "_alive"]
+    names += ["_minimap_cell"] if first.rules.view == "minimap" else []
+    for name in names:  # flat, world after world
+        flat = _joined([getattr(engine, name) for engine in engines])
+        setattr(new, name, flat.reshape(-1, s)[index].ravel())
+    own_start = _joined([  # each world's cell starts, counted from its first object
+        engine._cell_start[:-1].reshape(engine.n_worlds, n_cells)
+        - s * np.arange(engine.n_worlds)[:, None] for engine in engines])
+    new._cell_start = np.append((own_start[index] + s * np.arange(k)[:, None]).ravel(), k * s)
+    names = ["_ex", "_ey", "_enemy_alive", "agent", "_treasure", "_noise", "_noise_start", "t"]
+    names += ["_cell_money", "_visited"] if first.rules.view == "minimap" else []
+    for name in names:  # one row per world
+        setattr(new, name, _joined([getattr(engine, name) for engine in engines])[index])
+    rngs = [rng for engine in engines for rng in engine._rngs]
+    new._rngs = [rngs[i] for i in index]
+    if first._noise_states is not None:  # _draw_noise replaces these dicts, never edits them
+        states = [state for engine in engines for state in engine._noise_states]
+        new._noise_states = [states[i] for i in index]
+    data = _joined([engine.observation[0] for engine in engines])
+    shifts = np.cumsum([0] + [len(engine.observation[0]) for engine in engines])
+    offsets = np.append(_joined([engine.observation[1][:-1] + shift
+                                 for engine, shift in zip(engines, shifts)]), len(data))
+    sizes = np.diff(offsets)[index]
+    new_offsets = np.zeros(k + 1, dtype=np.intp)
+    np.cumsum(sizes, out=new_offsets[1:])
+    rows = np.repeat(offsets[index] - new_offsets[:-1], sizes) + np.arange(new_offsets[-1])
+    new.observation = (data[rows], new_offsets)
+    return new

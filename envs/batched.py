@@ -92,28 +92,48 @@ class _RaggedBatchSpace(spaces.Tuple):
 
 
 def _world_seeds(seed, n):
-    """Per-world seeds from `seed`: an int (world i gets seed + i) or n ints.
+    """Per-world seeds from `seed`: None (no world gets one), an int (world i gets seed + i)
+    or a sequence of n entries, each an int or None.
 
-    A `seed` that is neither an int nor a sequence, or a world seed that is not an int
-    (bools and floats included), raises a TypeError; a sequence of the wrong length or a
-    negative seed raises a ValueError.
+    A `seed` that is neither None, an int nor a sequence, or a world seed that is neither
+    None nor an int (bools and floats included), raises a TypeError; a sequence of the
+    wrong length or a negative seed raises a ValueError.
     """
+    if seed is None:
+        return [None] * n
     if isinstance(seed, Integral) and not isinstance(seed, bool):
         seeds = [int(seed) + i for i in range(n)]
     else:
         try:
             seeds = list(seed)
         except TypeError:
-            raise TypeError(f"seed must be None, an int or a sequence of {n} ints, "
-                            f"got {seed!r}") from None
+            raise TypeError(f"seed must be None, an int or a sequence of {n} ints (or "
+                            f"Nones), got {seed!r}") from None
         if len(seeds) != n:
             raise ValueError(f"seed has {len(seeds)} entries for {n} worlds")
     for s in seeds:
-        if not isinstance(s, Integral) or isinstance(s, bool):
-            raise TypeError(f"world seeds must be non-negative ints, got {s!r}")
-        if s < 0:
-            raise ValueError(f"world seeds must be non-negative ints, got {s!r}")
-    return [int(s) for s in seeds]
+        if s is not None and (not isinstance(s, Integral) or isinstance(s, bool)):
+            raise TypeError(f"world seeds must be None or non-negative ints, got {s!r}")
+        if s is not None and s < 0:
+            raise ValueError(f"world seeds must be None or non-negative ints, got {s!r}")
+    return [None if s is None else int(s) for s in seeds]
+
+
+def _check_reset_mask(mask, n):
+    """``options["reset_mask"]`` as an array of n bools, at least one True: the worlds to reset.
+
+    A mask that is not of bools raises a TypeError; one of another shape, or with no True,
+    a ValueError.
+    """
+    mask = np.asarray(mask)
+    if mask.shape != (n,):
+        raise ValueError(f"options['reset_mask'] must have shape ({n},), one bool per world; "
+                         f"got shape {mask.shape}")
+    if mask.dtype != np.bool_:
+        raise TypeError(f"options['reset_mask'] must be bools, got dtype {mask.dtype}")
+    if not mask.any():
+        raise ValueError("options['reset_mask'] resets no world: it needs at least one True")
+    return mask
 
 
 def _make_vec(num_envs, max_episode_steps=None, **kwargs):
@@ -169,21 +189,26 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
         `RaggedBatch` observations (and the tuples of per-world arrays).
     single_action_space : gymnasium.spaces.Discrete
     np_random_seed : int or tuple of int
-        The seed of the last seeded reset: the int ``s`` (world ``i`` got ``s + i``), as
-        gymnasium's vector envs record it, or the tuple of world seeds given. ``np_random``
-        is seeded with it; the worlds draw from generators of their own.
+        The seed of the last seeded reset of every world: the int ``s`` (world ``i`` got
+        ``s + i``), as gymnasium's vector envs record it; after a sequence of seeds or a
+        seeded partial reset, the tuple of the seeds the worlds' generators were last
+        seeded with. ``np_random`` is seeded with it; the worlds draw from generators of
+        their own.
 
     Notes
     -----
     Observations are a `RaggedBatch` (``obs.data``, ``obs.offsets``; ``obs[i]`` is world
     ``i``'s ``(n_i, 3)`` array; ``obs`` lies in `observation_space`). Rewards are
-    float64 of shape ``(num_envs,)``; episodes never terminate and all worlds are truncated
-    together after `max_steps` steps, by the env itself (``spec.max_episode_steps`` reports
-    it); that step returns the true final observations.
-    Autoreset follows gymnasium's next-step mode: the step after a truncation resets every
-    world (continuing its generator), ignores the actions and returns zero rewards; calling
-    `reset` explicitly instead is equivalent. `render` returns a tuple of one frame per world,
-    as gymnasium's vector envs do (drawing every world: render few of them).
+    float64 of shape ``(num_envs,)``; episodes never terminate and each world is truncated
+    after `max_steps` steps of its episode, by the env itself (``spec.max_episode_steps``
+    reports it); that step returns the true final observations. Worlds reset together stay
+    in step; ``reset(options={"reset_mask": mask})`` resets some of them only, as gymnasium's
+    vector envs do.
+    Autoreset follows gymnasium's next-step mode: the step after a world's truncation resets
+    that world (continuing its generator), ignores its action and returns a zero reward for
+    it, while the other worlds step; calling `reset` explicitly instead is equivalent.
+    `render` returns a tuple of one frame per world, as gymnasium's vector envs do (drawing
+    every world: render few of them).
 
     Examples
     --------
@@ -212,8 +237,10 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
         self.observation_space = _RaggedBatchSpace(
             batch_space(self.single_observation_space, self.num_envs).spaces)
         self._engine = _Engine(self.rules, self.num_envs)
-        self._rngs = None
-        self._autoreset = False
+        self._rngs = None  # each world's generator
+        self._seeds = None  # the seed each world's generator was last seeded with
+        self._autoreset = np.zeros(self.num_envs, dtype=bool)  # truncated by the last step
+        self._placed = False  # whether the worlds hold the objects of options["objects"]
 
     @property
     def n_types(self):
@@ -238,45 +265,77 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
         return self.rules.view_size
 
     def reset(self, *, seed=None, options=None):
-        """Draw a new world in every slot.
+        """Draw a new world in every slot, or in the slots of ``options["reset_mask"]``.
 
         Parameters
         ----------
-        seed : None, int or sequence of int, default=None
+        seed : None, int or sequence of (int or None), default=None
             An int ``s`` seeds world ``i`` with ``s + i``; a sequence gives one seed per
-            world. None continues each world's generator; the first time it draws an int
-            from fresh entropy and uses it as ``seed`` (so `np_random_seed` reproduces it).
+            world; None (for a world or for all) continues the world's generator. The first
+            reset seeds the worlds given none from fresh entropy: world ``i`` with ``e + i``
+            for one drawn int ``e``, which ``seed=None`` records as its seed (so
+            `np_random_seed` reproduces the reset). With a ``reset_mask``, only the seeds of
+            the worlds reset are used, as in gymnasium's vector envs.
         options : dict, optional
             ``{"objects": rows}`` places the same objects in every world instead of the
-            random ones, as in `ObjectWorldEnv.reset`.
+            random ones, as in `ObjectWorldEnv.reset`. ``{"reset_mask": mask}``, an array of
+            ``num_envs`` bools with at least one True, resets only the worlds where `mask`
+            is True: the others keep their state and go on with their episodes, and one
+            truncated by the last step is still reset by the next (gymnasium's partial
+            reset). A partial reset draws random worlds, so it takes no ``"objects"`` and
+            needs every world reset before, without ``"objects"``: all worlds hold as many
+            objects of each type.
 
         Returns
         -------
         obs : RaggedBatch
+            Every world's observation, the worlds not reset included.
         info : dict
 
         Raises
         ------
         TypeError
-            If `seed` is neither None, an int nor a sequence, or a world seed is not an int.
+            If `seed` is neither None, an int nor a sequence, a world seed is neither None
+            nor an int, or the reset mask is not of bools.
         ValueError
-            If a world seed is negative, a sequence does not hold one seed per world, or
-            `options` is malformed.
+            If a world seed is negative, a sequence does not hold one seed per world,
+            `options` is malformed, the reset mask is not of shape ``(num_envs,)`` or resets
+            no world, or a partial reset is given ``"objects"`` or follows a reset with
+            ``"objects"``.
+        RuntimeError
+            If a partial reset comes before the first reset.
         """
-        layout = _layout_from_options(options, self.rules)
-        if seed is None and self._rngs is None:
-            seed = np.random.SeedSequence().entropy
-        if seed is not None:
-            seeds = _world_seeds(seed, self.num_envs)
-            self._rngs = [seeding.np_random(s)[0] for s in seeds]
-            self._np_random_seed = seeds[0] if isinstance(seed, Integral) else tuple(seeds)
+        n = self.num_envs
+        layout = _layout_from_options(options, self.rules, ("objects", "reset_mask"))
+        mask = np.ones(n, dtype=bool)
+        if options is not None and "reset_mask" in options:
+            mask = _check_reset_mask(options["reset_mask"], n)
+        if not mask.all():
+            self._check_partial_reset(layout)
+        seeds = _world_seeds(seed, n)
+        if self._rngs is None:  # the first reset gives every world a generator
+            entropy = np.random.SeedSequence().entropy
+            seed = entropy if seed is None else seed
+            seeds = [entropy + i if s is None else s
+                     for i, s in enumerate(_world_seeds(seed, n))]
+            self._rngs, self._seeds = [None] * n, [None] * n
+        seeded = [i for i in np.flatnonzero(mask) if seeds[i] is not None]
+        for i in seeded:
+            self._rngs[i] = seeding.np_random(seeds[i])[0]
+            self._seeds[i] = seeds[i]
+        if seeded:
+            whole = isinstance(seed, Integral) and mask.all()
+            self._np_random_seed = seeds[0] if whole else tuple(self._seeds)
             self._np_random = np.random.default_rng(self._np_random_seed)
-        self._engine.reset(self._rngs, layout)
-        self._autoreset = False
+        self._reset_worlds(mask, layout)
+        self._autoreset &= ~mask
         return RaggedBatch(*self._engine.observation), {}
 
     def step(self, actions):
         """Apply one action per world.
+
+        A world truncated by the last step is reset instead (next-step autoreset): its
+        action is ignored, its reward is 0 and it is not truncated.
 
         Parameters
         ----------
@@ -302,13 +361,20 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
         if self._engine.observation is None:
             raise RuntimeError("call reset() before step()")
         n = self.num_envs
-        if self._autoreset:
-            obs, info = self.reset()
-            return obs, np.zeros(n), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool), info
-        rewards, truncated = self._engine.step(actions)
-        self._autoreset = truncated
+        pending = self._autoreset.copy()  # truncated by the last step: reset, not stepped
+        live = np.flatnonzero(~pending)
+        rewards, truncated = np.zeros(n), np.zeros(n, dtype=bool)
+        if len(live) == n:
+            rewards, truncated = self._engine.step(actions)
+        elif len(live):
+            moved = self._engine.take(live)
+            rewards[live], truncated[live] = moved.step(actions[live])
+            self._engine = self._engine.replaced(live, moved)
+        if pending.any():
+            self.reset(options={"reset_mask": pending})
+        self._autoreset = truncated.copy()
         return (RaggedBatch(*self._engine.observation), rewards, np.zeros(n, dtype=bool),
-                np.full(n, truncated), {})
+                truncated, {})
 
     def render(self):
         """One RGB frame per world (see `ObjectWorldEnv.render`), or None without render_mode.
@@ -320,6 +386,33 @@ class BatchedObjectWorld(_OwnEpisodeLimit, VectorEnv):
         if not _can_render(self):
             return None
         return tuple(_render_frame(self, i) for i in range(self.num_envs))
+
+    def _reset_worlds(self, mask, layout):
+        """Draw new worlds in the slots `mask`, each from its generator; the others go on."""
+        if mask.all():
+            self._engine.reset(list(self._rngs), layout)
+            self._placed = layout is not None
+        else:
+            worlds = np.flatnonzero(mask)
+            fresh = _Engine(self.rules, len(worlds))
+            fresh.reset([self._rngs[i] for i in worlds], layout)
+            self._engine = self._engine.replaced(worlds, fresh)
+
+    def _check_partial_reset(self, layout):
+        """Raise unless some worlds can be reset without the others (see `reset`).
+
+        The engine holds as many objects of each type in every world, so a partial reset
+        draws random worlds beside random worlds only.
+        """
+        if self._rngs is None:
+            raise RuntimeError("call reset() on every world before a partial reset "
+                               "(options['reset_mask'])")
+        if layout is not None:
+            raise ValueError("options['objects'] places the objects of every world: reset "
+                             "every world with it, not a part (options['reset_mask'])")
+        if self._placed:
+            raise ValueError("the worlds hold the objects of options['objects']: reset every "
+                             "world before resetting a part of them (options['reset_mask'])")
 
     def _check_actions(self, actions):
         array = np.asarray(actions)

@@ -25,13 +25,17 @@ def _object_space(rules):
     return spaces.Sequence(row, stack=True)
 
 
-def _layout_from_options(options, rules):
-    """The explicit object layout of ``reset(options={"objects": rows})``, or None."""
+def _layout_from_options(options, rules, keys=("objects",)):
+    """The explicit object layout of ``reset(options={"objects": rows})``, or None.
+
+    `options` must be None or a dict of no keys but `keys`.
+    """
     if options is None:
         return None
-    if not isinstance(options, dict) or set(options) - {"objects"}:
-        raise ValueError(f"reset options must be None or a dict with the only key 'objects', "
-                         f"got {options!r}")
+    if not isinstance(options, dict) or set(options) - set(keys):
+        names = " and ".join(repr(key) for key in keys)
+        raise ValueError(f"reset options must be None or a dict with the only "
+                         f"key{'s' if len(keys) > 1 else ''} {names}, got {options!r}")
     return _check_layout(options["objects"], rules) if "objects" in options else None
 
 
@@ -268,11 +272,11 @@ class ObjectWorldEnv(_OwnEpisodeLimit, gym.Env):
         action = _check_action(action, self.rules.n_actions)
         if self._engine.observation is None:
             raise RuntimeError("call reset() before step()")
-        if self._engine.t >= self.rules.max_steps:
+        if self._engine.t[0] >= self.rules.max_steps:
             raise RuntimeError(f"the episode was truncated after {self.rules.max_steps} steps; "
                                "call reset()")
         rewards, truncated = self._engine.step(np.array([action]))
-        return self._engine.observation[0], float(rewards[0]), False, truncated, {}
+        return self._engine.observation[0], float(rewards[0]), False, bool(truncated[0]), {}
 
     def render(self):
         """An RGB frame (uint8, ``(side, side, 3)``) of the world or of the local view."""

@@ -103,7 +103,8 @@ def _plan_routes(x, y, value, n_coins, valid, start, budget, rules, width):
     valid : ndarray of bool of shape (n_worlds, n_targets)
         Targets still there.
     start : ndarray of shape (n_worlds, 2)
-    budget : int
+    budget : ndarray of int of shape (n_worlds,)
+        Each world's steps left.
     rules : WorldRules
     width : int
 
@@ -133,7 +134,7 @@ def _plan_routes(x, y, value, n_coins, valid, start, budget, rules, width):
                                   y[world, n_coins:], rules.swipe_size))
         leg, end_x, end_y = (np.concatenate(part, axis=1) for part in zip(*legs))
         arrival = steps[:, None] + leg
-        parent, target = np.nonzero(~taken & (arrival <= budget))
+        parent, target = np.nonzero(~taken & (arrival <= budget[world][:, None]))
         if len(parent) == 0:
             break
         w = world[parent]
@@ -332,17 +333,20 @@ class LookaheadPlanner:
         TypeError
             If `env` is not an ObjectWorld env.
         RuntimeError
-            If it was not reset, or its episode is over.
+            If it was not reset, or the episode of one of its worlds is over.
         """
         base, engine = self._unwrap(env)
-        horizon = min(self.depth, engine.rules.max_steps - engine.t)
         n_actions = engine.rules.n_actions
-        kept = min(self.width, n_actions ** (horizon - 1))
-        group = max(1, _MAX_NODES // (kept * n_actions))
+        steps_left = engine.rules.max_steps - engine.t
         actions = np.empty(engine.n_worlds, dtype=np.intp)
-        for start in range(0, engine.n_worlds, group):
-            worlds = np.arange(start, min(start + group, engine.n_worlds))
-            actions[worlds] = self._search(engine, worlds, horizon)
+        for left in np.unique(steps_left):  # worlds reset on their own are at other steps
+            same = np.flatnonzero(steps_left == left)
+            horizon = min(self.depth, int(left))
+            kept = min(self.width, n_actions ** (horizon - 1))
+            group = max(1, _MAX_NODES // (kept * n_actions))
+            for start in range(0, len(same), group):
+                worlds = same[start:start + group]
+                actions[worlds] = self._search(engine, worlds, horizon)
         return actions if isinstance(base, BatchedObjectWorld) else int(actions[0])
 
     def play(self, env, seed=None):
@@ -381,7 +385,7 @@ class LookaheadPlanner:
         engine = base._engine
         if reset and engine.observation is None:
             raise RuntimeError("call env.reset() before planning")
-        if reset and engine.t >= engine.rules.max_steps:
+        if reset and (engine.t >= engine.rules.max_steps).any():
             raise RuntimeError(f"the episode is over (truncated after {engine.rules.max_steps} "
                                "steps); call env.reset()")
         return base, engine
