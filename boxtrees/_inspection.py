@@ -36,7 +36,9 @@ class _Scores:
                             "columns; type_importance and region_importance read object sets")
         self.sets = as_object_sets(X)
         present = np.unique(self.sets.data[:, -1]).astype(np.intp)
-        self.types = present if types is None else np.asarray(types, dtype=np.intp).ravel()
+        self.types = present if types is None else np.asarray(types).ravel()
+        if self.types.dtype.kind not in "iu" or not self.types.size:
+            raise ValueError(f"types must be one or more type ids (integers); got {types!r}")
         absent = np.setdiff1d(self.types, present)
         if absent.size:
             raise ValueError(f"types {absent.tolist()} have no object in X (its types: "
@@ -116,7 +118,7 @@ def type_importance(estimator, X, y, *, method="permute", types=None, scoring=No
     TypeError
         If ``X`` is a feature matrix (use ``sklearn.inspection.permutation_importance``).
     ValueError
-        If one of ``types`` has no object in ``X``.
+        If ``types`` are not type ids, or one of them has no object in ``X``.
 
     See Also
     --------
@@ -216,7 +218,8 @@ def region_importance(estimator, X, y, *, n_bins=4, method="drop", types=None, e
     TypeError
         If ``X`` is a feature matrix.
     ValueError
-        If one of ``types`` has no object in ``X``, or ``extent`` is not a region.
+        If ``types`` are not type ids, or one of them has no object in ``X``, or ``extent``
+        is not a region.
 
     See Also
     --------

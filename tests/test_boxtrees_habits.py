@@ -334,6 +334,9 @@ def test_type_importance_permutes_only_the_objects_of_the_type():
     assert result.importances_mean[1] > 0.3 and abs(result.importances_mean[0]) < 0.02
     with pytest.raises(ValueError, match=r"types \[5\] have no object in X"):
         type_importance(forest, X, y, types=[5])
+    for bad in ([], [0.5], ["coin"]):
+        with pytest.raises(ValueError, match="types must be one or more type ids"):
+            type_importance(forest, X, y, types=bad)
 
 
 def test_region_importance_maps_where_each_type_matters(box_forest):
