@@ -10,8 +10,9 @@ Importing this package registers
 Every rule constant is a keyword argument (see `WorldRules`), e.g.
 ``gymnasium.make("ObjectWorldTreasure-v0", view="arrow", enemy_speed=0)``;
 ``gymnasium.make_vec(id, num_envs=400)`` builds a `BatchedObjectWorld`. The envs truncate
-their episodes themselves after ``max_steps`` steps, so the ids register no
-``max_episode_steps`` (gymnasium adds no `TimeLimit`); the spec of a made env reports it.
+their episodes themselves after ``max_steps`` steps; the ids register the default,
+``max_episode_steps=50``, so ``gymnasium.spec(id)`` reports it and the `TimeLimit` that
+``gymnasium.make`` adds truncates on the same step (see `ObjectWorldEnv` for other lengths).
 """
 from gymnasium.envs.registration import register
 
@@ -34,8 +35,9 @@ __all__ = [
     "TYPE_NAMES", "TYPE_COLOURS", "ACTION_NAMES", "VIEWS",
 ]
 
-_ENTRY_POINTS = {"entry_point": "envs.object_world:ObjectWorldEnv",
-                 "vector_entry_point": "envs.batched:_make_vec"}
-register(id="ObjectWorld-v0", **_ENTRY_POINTS)
-register(id="ObjectWorldSword-v0", kwargs={"sword": True}, **_ENTRY_POINTS)
-register(id="ObjectWorldTreasure-v0", kwargs={"treasure": True}, **_ENTRY_POINTS)
+_SPEC = {"entry_point": "envs.object_world:ObjectWorldEnv",
+         "vector_entry_point": "envs.batched:_make_vec",
+         "max_episode_steps": WorldRules.max_steps}
+register(id="ObjectWorld-v0", **_SPEC)
+register(id="ObjectWorldSword-v0", kwargs={"sword": True}, **_SPEC)
+register(id="ObjectWorldTreasure-v0", kwargs={"treasure": True}, **_SPEC)

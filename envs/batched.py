@@ -139,10 +139,12 @@ def _check_reset_mask(mask, n):
 def _make_vec(num_envs, max_episode_steps=None, **kwargs):
     """Vector entry point of the registered ids: ``gymnasium.make_vec(id, num_envs)``.
 
-    gymnasium passes ``max_episode_steps`` to a vector entry point (it does when remaking the
-    env from its spec); it is the `max_steps` rule, which the batched env applies itself.
+    gymnasium passes ``max_episode_steps`` to a vector entry point: the one given to
+    ``make_vec`` or recorded in the spec it remakes, else the id's registered one, the
+    default `max_steps`. It is the `max_steps` rule, which the batched env applies itself;
+    a `max_steps` given beside the default wins, another ``max_episode_steps`` must agree.
     """
-    if max_episode_steps is not None:
+    if max_episode_steps is not None and max_episode_steps != WorldRules.max_steps:
         max_steps = kwargs.setdefault("max_steps", max_episode_steps)
         if max_steps != max_episode_steps:
             raise ValueError(f"max_episode_steps={max_episode_steps!r} and max_steps="

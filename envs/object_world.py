@@ -71,11 +71,11 @@ def _render_frame(env, i):
 class _OwnEpisodeLimit:
     """Gives an env's `spec` the env's own episode limit, ``max_episode_steps = max_steps``.
 
-    The env truncates its episodes itself, after ``rules.max_steps`` steps. The registered ids
-    therefore have no ``max_episode_steps`` of their own: ``gymnasium.make`` would add a
-    `TimeLimit` at that number, which knows nothing of a ``max_steps`` passed to ``make``
-    and would cut longer episodes short. Instead the spec that gymnasium sets on the env
-    (``make``, ``make_vec``) reports the env's limit, so gymnasium's tools see it.
+    The env truncates its episodes itself, after ``rules.max_steps`` steps. The spec that
+    gymnasium sets on the env (``make``, ``make_vec``) would hold the id's registered
+    ``max_episode_steps`` (``make_vec``) or none (``make``, which keeps it for the
+    `TimeLimit` it wraps the env in), whatever ``max_steps`` was passed; it reports the
+    env's limit instead.
     """
 
     _spec = None
@@ -162,12 +162,17 @@ class ObjectWorldEnv(_OwnEpisodeLimit, gym.Env):
     ``Sequence(Box(3,), stack=True)``. Actions: ``Discrete(4)``, ``0`` up, ``1`` right,
     ``2`` down, ``3`` left; ``Discrete(8)`` with the sword, ``4..7`` swiping in the same
     directions. Reward: the sum of the step's contacts and swipe. Episodes never terminate;
-    they are truncated after `max_steps` steps, by the env itself: the registered ids add no
-    gymnasium `TimeLimit`, and ``env.spec.max_episode_steps`` reports `max_steps` (the
-    `TimeLimit` that ``gymnasium.make(env.spec)`` adds at that limit truncates on the same
-    step; one from ``gymnasium.make(id, max_episode_steps=k)`` can only cut episodes short,
-    so set their length with `max_steps`). Each reset draws a new world from
-    ``self.np_random``; ``reset(seed=s)`` sets ``np_random_seed`` to ``s``.
+    they are truncated after `max_steps` steps, by the env itself. The registered ids declare
+    the default limit, ``max_episode_steps=50`` (``gymnasium.spec(id)`` reports it), so
+    ``gymnasium.make(id)`` wraps the env in a `TimeLimit` at 50 that truncates on the same
+    step. gymnasium gives ``max_episode_steps`` to that `TimeLimit` and never to the env, so
+    with ``gymnasium.make`` set another length with both, ``max_steps=k`` and
+    ``max_episode_steps=k``: alone, a `max_steps` above 50 is cut at 50 by the `TimeLimit`,
+    and a ``max_episode_steps`` above `max_steps` is never reached. ``gymnasium.make_vec``
+    and the classes take `max_steps` alone; a made env's ``spec.max_episode_steps`` is its
+    `TimeLimit`'s, and ``env.unwrapped.spec.max_episode_steps`` its `max_steps`. Each reset
+    draws a new world from ``self.np_random``; ``reset(seed=s)`` sets ``np_random_seed`` to
+    ``s``.
 
     Examples
     --------

@@ -85,21 +85,19 @@ def test_np_random_seed_is_the_reset_seed():
     assert worlds.np_random_seed == 5  # world i has seed 5 + i, as in gymnasium's vector envs
 
 
-def test_spec_carries_the_episode_limit_without_a_time_limit_wrapper():
+def test_spec_carries_the_episode_limit():
     env = gym.make("ObjectWorld-v0")
     assert env.spec.max_episode_steps == 50 == env.unwrapped.spec.max_episode_steps
-    longer = gym.make("ObjectWorldSword-v0", max_steps=70)
-    assert longer.spec.max_episode_steps == 70
-    wrapper = longer
-    while wrapper is not wrapper.unwrapped:
-        assert not isinstance(wrapper, gym.wrappers.TimeLimit)
-        wrapper = wrapper.env
-    remade = gym.make(longer.spec)  # adds a TimeLimit at the env's own limit
+    longer = gym.make("ObjectWorldSword-v0", max_steps=70, max_episode_steps=70)
+    assert longer.spec.max_episode_steps == 70 == longer.unwrapped.spec.max_episode_steps
+    remade = gym.make(longer.spec)  # adds the TimeLimit at the env's own limit again
     assert remade.spec.max_episode_steps == 70 and remade.unwrapped.rules.max_steps == 70
     for env in (longer, remade):
         env.reset(seed=2)
         truncations = [env.step(t % 8)[3] for t in range(70)]
         assert truncations == [False] * 69 + [True]
+    shorter = gym.make("ObjectWorld-v0", max_steps=20)  # its TimeLimit at 50 is never reached
+    assert shorter.spec.max_episode_steps == 50 and shorter.unwrapped.spec.max_episode_steps == 20
     assert envs.ObjectWorldEnv().spec is None
 
 

@@ -1,10 +1,88 @@
-"""gymnasium habits on the ObjectWorld envs: the partial reset of the batched env
-(``reset(options={"reset_mask": mask})``) against gymnasium's own vector env of single envs."""
+"""gymnasium habits on the ObjectWorld envs: the registered episode limit, and the partial
+reset of the batched env (``reset(options={"reset_mask": mask})``) against gymnasium's own
+vector env of single envs."""
 import gymnasium as gym
 import numpy as np
 import pytest
 
 import envs
+
+IDS = {"ObjectWorld-v0": {}, "ObjectWorldSword-v0": {"sword": True},
+       "ObjectWorldTreasure-v0": {"treasure": True}}
+
+
+def _time_limits(env):
+    """The limits of the `TimeLimit` wrappers around `env`, outermost first."""
+    limits = []
+    while env is not env.unwrapped:
+        if isinstance(env, gym.wrappers.TimeLimit):
+            limits.append(env._max_episode_steps)
+        env = env.env
+    return limits
+
+
+def _play(env, seeds, actions):
+    """Every step's ``(obs, reward, terminated, truncated)`` of `env`, one episode per seed
+    and a reset after the last, each episode played until truncated."""
+    record = []
+    for seed in seeds:
+        obs, _ = env.reset(seed=seed)
+        record.append((obs,))
+        truncated, t = False, 0
+        while not truncated:
+            obs, reward, terminated, truncated, _ = env.step(int(actions[t]))
+            record.append((obs, reward, terminated, truncated))
+            t += 1
+    return record
+
+
+def _assert_same_play(a, b):
+    assert len(a) == len(b)
+    for x, y in zip(a, b):
+        np.testing.assert_array_equal(x[0], y[0])
+        assert x[1:] == y[1:]
+
+
+# ------------------------------------------------------------------ the registered limit
+@pytest.mark.parametrize("env_id", IDS)
+def test_gymnasium_sees_the_registered_episode_limit(env_id):
+    """The ids declare the default limit; a length given to ``make_vec`` in either keyword
+    wins over it (gymnasium hands the registered one to the vector entry point)."""
+    assert gym.spec(env_id).max_episode_steps == envs.WorldRules().max_steps == 50
+    made = gym.make(env_id)
+    assert _time_limits(made) == [50] and made.spec.max_episode_steps == 50
+    assert made.unwrapped.spec.max_episode_steps == 50
+    assert gym.make_vec(env_id, num_envs=2).spec.max_episode_steps == 50
+    for length in ({"max_steps": 70}, {"max_episode_steps": 70},
+                   {"max_steps": 70, "max_episode_steps": 70}):
+        worlds = gym.make_vec(env_id, num_envs=3, **length)
+        assert isinstance(worlds, envs.BatchedObjectWorld)
+        assert worlds.rules.max_steps == 70 and worlds.spec.max_episode_steps == 70
+        assert gym.make_vec(worlds.spec).rules == worlds.rules
+        worlds.reset(seed=0)
+        truncations = [worlds.step(np.zeros(3, dtype=int))[3].all() for _ in range(70)]
+        assert truncations == [False] * 69 + [True]
+
+
+@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize("make_kwargs, length", [
+    ({}, 50),
+    ({"max_steps": 20}, 20),
+    ({"max_steps": 70, "max_episode_steps": 70}, 70),
+])
+def test_make_plays_the_env_s_own_episodes(env_id, make_kwargs, length):
+    """``gymnasium.make`` adds a `TimeLimit` that truncates on the env's own step or never:
+    the episodes are those of the env built directly, and so are a remake's."""
+    rules = {**IDS[env_id], "max_steps": length}
+    actions = np.random.default_rng(0).integers(4, size=length)
+    expected = _play(envs.ObjectWorldEnv(**rules), [3, None], actions)
+    assert [len(step) == 4 and step[3] for step in expected].count(True) == 2
+    made = gym.make(env_id, **make_kwargs)
+    assert made.unwrapped.rules.max_steps == length
+    limits = _time_limits(made)
+    assert limits and all(limit >= length for limit in limits)
+    _assert_same_play(_play(made, [3, None], actions), expected)
+    _assert_same_play(_play(gym.make(made.spec), [3, None], actions), expected)
 
 
 # ------------------------------------------------------------------ the partial reset
