@@ -2,8 +2,8 @@
 
 Both run the uniform random policy (actions drawn beforehand, so only the env is timed),
 resetting every episode (50 steps). The single env is timed as the raw class and through
-``gymnasium.make`` (which adds the passive checker and order-enforcing wrappers); the ratio
-uses the raw class, the faster of the two.
+``gymnasium.make`` (which adds the passive checker, order-enforcing and time-limit
+wrappers); the ratio uses the raw class, the faster of the two.
 
 Prints a table and writes ``bench_env.json`` under ``--out``.
 
