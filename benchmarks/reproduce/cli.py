@@ -6,6 +6,7 @@ from collections import Counter
 from pathlib import Path
 
 from .budgets import BUDGETS
+from .cache import load_unit
 from .registry import EXPERIMENTS, REGISTRY
 from .report import write_outputs
 from .runner import MAX_ATTEMPTS, ClusterError, cluster, plan, run
@@ -122,8 +123,13 @@ def _parser():
                            "(docs/reproduction.md)")
     dask.add_argument("--dask-local", type=_count, metavar="N",
                       help="run on a Dask cluster of N worker processes on this machine")
-    parser.add_argument("--report-only", action="store_true",
-                        help="run nothing; rebuild figures and REPORT.md from cached runs")
+    nothing = parser.add_mutually_exclusive_group()
+    nothing.add_argument("--report-only", action="store_true",
+                         help="run nothing; rebuild figures and REPORT.md from cached runs")
+    nothing.add_argument("--plan", action="store_true",
+                         help="run and write nothing; print how many runs the command plans, "
+                              "how many are not cached under --out and the runner's estimate "
+                              "of their time")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     return parser
 
@@ -138,8 +144,9 @@ def main(argv=None):
 
     Returns
     -------
-    report : pathlib.Path
-        The written REPORT.md.
+    report : pathlib.Path or None
+        The written REPORT.md; None with ``--plan``, which writes nothing and prints what
+        the command would run (`_plan_line`).
 
     Raises
     ------
@@ -160,6 +167,9 @@ def main(argv=None):
     start = time.perf_counter()
     try:
         units = plan(experiments, budget, args.out, args.seeds)
+        if args.plan:
+            print(_plan_line(units, budget))
+            return None
         done, skipped = ([], []) if args.report_only else _run(units, budget, args)
         elapsed = time.perf_counter() - start
         # a report-only invocation ran nothing: its header says so by omitting the timing
@@ -181,6 +191,16 @@ def main(argv=None):
                        f"{MAX_ATTEMPTS} times (listed above); the report counts them as "
                        f"missing\n")
     return report
+
+
+def _plan_line(units, budget):
+    """The units planned, those not cached, and the runner's estimate of their time: the sum
+    of their `Unit.cost` (seconds on 2 free cores, one run at a time) and the longest."""
+    todo = [unit for unit in units if load_unit(unit) is None]
+    costs = [unit.cost() / 3600 for unit in todo]
+    return (f"{len(units)} runs planned at the {budget.name} budget, {len(todo)} of them not "
+            f"cached: about {sum(costs):.1f} h by the runner's estimate (2 free cores, one run "
+            f"at a time), the longest {max(costs, default=0.0):.1f} h")
 
 
 def _run(units, budget, args):

@@ -5,11 +5,11 @@ import errno
 import pytest
 
 from benchmarks.reproduce import REGISTRY, runner
-from benchmarks.reproduce.cache import attempts, mark_attempt
+from benchmarks.reproduce.cache import attempts, mark_attempt, save_unit
 from benchmarks.reproduce.cli import main, parse_seeds
 from benchmarks.reproduce.runner import MAX_ATTEMPTS, plan
 
-from harness import TINY, interrupt
+from harness import FQI_RESULT, TINY, interrupt
 
 
 def test_parse_seeds():
@@ -116,3 +116,17 @@ def test_an_interrupted_command_says_so_in_one_line(tmp_path, capsys, monkeypatc
         "command to resume"]
     unit, = plan([REGISTRY["attention"]], TINY, tmp_path)
     assert attempts(unit.path) == 0
+
+
+def test_plan_prints_the_runs_and_the_runner_s_estimate_and_writes_nothing(tmp_path, capsys):
+    units = plan([REGISTRY["fqi_nmin"]], TINY, tmp_path)
+    argv = ["--budget", "tiny", "--only", "fqi_nmin", "--out", str(tmp_path), "--plan"]
+    for cached in (0, 1):
+        hours = [unit.cost() / 3600 for unit in units[cached:]]
+        assert main(argv) is None
+        assert capsys.readouterr().out == (
+            f"{len(units)} runs planned at the tiny budget, {len(units) - cached} of them not "
+            f"cached: about {sum(hours):.1f} h by the runner's estimate (2 free cores, one run "
+            f"at a time), the longest {max(hours):.1f} h\n")
+        save_unit(units[0], FQI_RESULT)
+    assert [path.name for path in tmp_path.rglob("*") if path.is_file()] == ["seed0.json"]
