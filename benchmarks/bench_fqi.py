@@ -67,7 +67,7 @@ def run_fqi(name, iterations, samples, seed):
               + f" {r['t_total']:>6.2f}s", flush=True)
 
     start = time.perf_counter()
-    agent.learn(iterations, callback=show)
+    agent.learn(n_iterations=iterations, callback=show)
     seconds = time.perf_counter() - start
     curve = [r["reward"] for r in agent.history]
     return {"name": name, "kind": "fqi", "params": {k: str(v) for k, v in params.items()},

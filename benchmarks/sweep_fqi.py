@@ -67,7 +67,7 @@ def main():
             start = time.perf_counter()
             agent = make_agent(KINDS["fqi"].settings(_params(settings(value), args.trees)),
                                BUDGETS["full"], seed, args.samples)
-            curve = [r["reward"] for r in agent.learn(args.iterations).history]
+            curve = [r["reward"] for r in agent.learn(n_iterations=args.iterations).history]
             seconds = time.perf_counter() - start
             last = float(np.mean(curve[-5:]))
             runs.append({args.what: value, "seed": seed, "curve": curve, "last5_mean": last,

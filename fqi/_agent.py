@@ -35,8 +35,9 @@ _LEARNED = ("q_functions_", "history", "num_timesteps", "iteration", "observatio
 
 
 class FQI:
-    """Fitted Q-iteration on any gymnasium env with discrete actions, in the data regimes
-    of the thesis (section 3.2.2).
+    """Fitted Q-iteration on any gymnasium env with discrete actions: a growing batch of
+    transitions, several fitted-Q backups per collection round, and the data regimes of the
+    thesis (section 3.2.2).
 
     The Q-function is one regressor per action, each a fresh `sklearn.base.clone` of
     `regressor` fitted at every iteration; the agent only calls ``fit(X, y)`` and
@@ -46,13 +47,16 @@ class FQI:
     `boxtrees.ObjectSets` (``data`` + ``offsets``) per batch, which
     `boxtrees.BoxExtraTreesRegressor` or a pipeline starting with `boxtrees.GridCounts` take.
 
-    Iteration ``n`` of `learn`:
+    `learn` runs collection rounds, each followed by `resample_every` iterations (fitted-Q
+    backups on the data kept so far: the backups, not the collections, carry value over a
+    horizon of about ``1 / (1 - gamma)`` steps). Iteration ``n``:
 
     1. *collect* (iteration 0, then every `resample_every` iterations):
        `samples_per_iteration` transitions from the `n_envs` envs of a gymnasium vector env,
        with the uniform random policy at iteration 0 and the epsilon-greedy policy of
-       ``Q_{n-1}`` later. They replace the data set, or with `keep_data` are appended to it
-       (oldest dropped beyond `max_samples`);
+       ``Q_{n-1}`` later, epsilon falling as in stable-baselines3's DQN. With `keep_data`
+       they are appended to the data set (oldest dropped beyond `max_samples`), else they
+       replace it;
     2. *targets*: ``r`` at iteration 0, then ``r + gamma * max_a Q_{n-1}(s', a)`` for every
        transition in the data set (no bootstrap after a termination; a truncation, such as
        a time limit, is bootstrapped through with the true final observation);
@@ -79,23 +83,29 @@ class FQI:
         any other env is copied `n_envs` times (``copy.deepcopy``); a callable is called
         once per env; a vector env is used as it is. The env is tried once here (a reset
         and a step): an env that raises gives a RuntimeError naming the call.
-    gamma : float, default=0.5
-        Discount factor in ``[0, 1)``. 0.5 scored best on ObjectWorld (``docs/fqi.md``,
-        "Discount factor"); control tasks with long horizons need more (0.99 on CartPole).
-    epsilon : float, default=0.2
-        Probability of a uniform random action while collecting (thesis: 0.2).
-    samples_per_iteration : int, default=20_000
-        Transitions collected per collection (thesis: 20,000).
-    resample_every : int or None, default=1
-        Collect new data every this many iterations: 1 is the thesis's "normal" regime,
-        5 its "mixed" one; None collects only at iteration 0 (offline FQI, as first
-        formulated).
-    keep_data : bool, default=False
-        Append new transitions to the earlier ones instead of replacing them, keeping the
-        most recent `max_samples` (a cure for the forgetting the thesis blames for its
-        crashes).
+    gamma : float, default=0.99
+        Discount factor in ``[0, 1)``, stable-baselines3's default. The thesis's game scored
+        best with 0.5 (``docs/fqi.md``, "Discount factor").
+    samples_per_iteration : int, default=2_500
+        Transitions collected per collection round (the thesis: 20,000).
+    resample_every : int or None, default=5
+        Iterations (fitted-Q backups) per collection round: 1 is the thesis's "normal"
+        regime, 5 its "mixed" one; None collects only at iteration 0 (offline FQI, as first
+        formulated; see also `learn_offline`).
+    keep_data : bool, default=True
+        Append new transitions to the earlier ones (a growing batch, as a replay buffer),
+        keeping the most recent `max_samples`; False replaces them (the thesis's regimes).
     max_samples : int, default=100_000
-        Cap on the data set size when `keep_data` is True.
+        Cap on the data set size when `keep_data` is True (stable-baselines3's
+        ``buffer_size``).
+    exploration_fraction : float, default=0.1
+        Share of `learn`'s ``total_timesteps`` over which the probability of a random action
+        falls from `exploration_initial_eps` to `exploration_final_eps` (stable-baselines3's
+        DQN schedule; with ``n_iterations``, the share of the iterations).
+    exploration_initial_eps, exploration_final_eps : float, default=1.0, 0.05
+        Probability of a uniform random action while collecting, at the start and at the end
+        of the schedule (the thesis: 0.2 throughout). The first round plays uniformly at
+        random whatever they are: there is no Q-function yet.
     n_envs : int, default=None
         Envs played side by side while collecting; None: the vector env's own number, or
         16 for any other env form.
@@ -129,6 +139,8 @@ class FQI:
 
     Attributes
     ----------
+    exploration_rate : float
+        The current probability of a random action (of the next collection).
     q_functions_ : list of regressors
         The fitted ``Q_n``, one per action.
     history : list of dict
@@ -154,23 +166,28 @@ class FQI:
     >>> from sklearn.ensemble import ExtraTreesRegressor
     >>> from fqi import FQI
     >>> agent = FQI(ExtraTreesRegressor(n_estimators=10, random_state=0), "CartPole-v1",
-    ...             gamma=0.99, samples_per_iteration=1000, eval_episodes=2, seed=0)
-    >>> [r["iteration"] for r in agent.learn(2).history]
-    [0, 1]
+    ...             samples_per_iteration=500, resample_every=2, n_envs=1, eval_episodes=2,
+    ...             seed=0)
+    >>> agent = agent.learn(total_timesteps=1000)
+    >>> agent.num_timesteps, [r["iteration"] for r in agent.history]
+    (1000, [0, 1, 2, 3])
     >>> agent.predict(agent.observation_space.sample())[0] in (0, 1)
     True
     """
 
-    def __init__(self, regressor, env, gamma=0.5, epsilon=0.2, samples_per_iteration=20_000,
-                 resample_every=1, keep_data=False, max_samples=100_000, n_envs=None,
-                 eval_episodes=None, eval_seeds=None, eval_env=None, n_jobs=1,
-                 log_path=None, seed=None, verbose=0):
+    def __init__(self, regressor, env, gamma=0.99, samples_per_iteration=2_500,
+                 resample_every=5, keep_data=True, max_samples=100_000,
+                 exploration_fraction=0.1, exploration_initial_eps=1.0,
+                 exploration_final_eps=0.05, n_envs=None, eval_episodes=None,
+                 eval_seeds=None, eval_env=None, n_jobs=1, log_path=None, seed=None,
+                 verbose=0):
         self._set_params({name: value for name, value in locals().items() if name != "self"})
         world_seq, action_seq, fit_seq = np.random.SeedSequence(self.seed).spawn(3)
         self._world_rng = np.random.default_rng(world_seq)
         self._action_rng = np.random.default_rng(action_seq)
         self._fit_rng = np.random.default_rng(fit_seq)
         self.observation_space = self.action_space = None
+        self.exploration_rate = self.exploration_initial_eps
         self.q_functions_ = None
         self._q_iteration = None  # the iteration that fitted q_functions_
         self.history = []
@@ -197,7 +214,12 @@ class FQI:
         if self.eval_env is not None:
             _check_env(self.eval_env, "eval_env")
         self.gamma = _check_real("gamma", params["gamma"], 0.0, 1.0, high_inclusive=False)
-        self.epsilon = _check_real("epsilon", params["epsilon"], 0.0, 1.0)
+        self.exploration_fraction = _check_real("exploration_fraction",
+                                                params["exploration_fraction"], 0.0, 1.0)
+        self.exploration_initial_eps = _check_real("exploration_initial_eps",
+                                                   params["exploration_initial_eps"], 0.0, 1.0)
+        self.exploration_final_eps = _check_real("exploration_final_eps",
+                                                 params["exploration_final_eps"], 0.0, 1.0)
         self.samples_per_iteration = _check_int("samples_per_iteration",
                                                 params["samples_per_iteration"], 1)
         resample_every = params["resample_every"]
@@ -352,12 +374,19 @@ class FQI:
         self._logger = logger
 
     # ------------------------------------------------------------------ training
-    def learn(self, n_iterations, callback=None, progress_bar=False):
-        """Run `n_iterations` FQI iterations (continuing from earlier calls).
+    def learn(self, total_timesteps=None, callback=None, progress_bar=False, *,
+              n_iterations=None):
+        """Train for `total_timesteps` more environment steps, or `n_iterations` more
+        iterations (continuing from earlier calls).
 
         Parameters
         ----------
-        n_iterations : int
+        total_timesteps : int, default=None
+            Environment steps to collect, in rounds of `samples_per_iteration` (the last one
+            shorter), each followed by its `resample_every` iterations. A round keeps exactly
+            its number of transitions; `num_timesteps` counts every env step, so it grows by
+            exactly `total_timesteps` with one env, and by up to ``n_envs - 1`` more with
+            several (they step together: the last step of a round may go past its count).
         callback : callable, BaseCallback or list, default=None
             Called after every iteration. A stable-baselines3 ``BaseCallback`` or
             ``CallbackList`` is taken as it is, with the agent as its ``model``:
@@ -368,13 +397,25 @@ class FQI:
             (``locals_["self"]`` is the agent, ``locals_["record"]`` the record). A list
             calls each in turn. A False return stops training (None continues).
         progress_bar : bool, default=False
-            Show a tqdm bar over the iterations, with the last evaluation reward.
+            Show a tqdm bar over the steps (or iterations), with the last evaluation reward.
+        n_iterations : int, default=None
+            Instead of `total_timesteps`: this many iterations, collecting every
+            `resample_every` of them (the thesis's protocol; the only way with
+            ``resample_every=None``).
 
         Returns
         -------
         self : FQI
         """
-        n_iterations = _check_int("n_iterations", n_iterations, 1)
+        if (total_timesteps is None) == (n_iterations is None):
+            raise TypeError("learn takes total_timesteps or n_iterations (one of them)")
+        if total_timesteps is not None:
+            total_timesteps = _check_int("total_timesteps", total_timesteps, 1)
+            if self.resample_every is None:
+                raise ValueError("resample_every=None collects once: learn(n_iterations=...) "
+                                 "sets how many iterations run on that data")
+        else:
+            n_iterations = _check_int("n_iterations", n_iterations, 1)
         callback = _as_callback(callback)
         progress_bar = _check_bool("progress_bar", progress_bar)
         if self._env is None:
@@ -384,26 +425,51 @@ class FQI:
             self._collector = _Collector(self._env, self._observations, self._world_rng)
         callback.init_callback(self)
         callback.on_training_start(locals(), globals())
-        with tqdm(total=n_iterations, desc="FQI", disable=not progress_bar) as bar:
-            for _ in range(n_iterations):
-                record = self._iterate()
+        start_steps, done = self.num_timesteps, 0
+        with tqdm(total=total_timesteps or n_iterations, desc="FQI",
+                  unit="steps" if total_timesteps else "it", disable=not progress_bar) as bar:
+            while True:
+                if n_iterations is not None:
+                    if done == n_iterations:
+                        break
+                    progress, budget = done / n_iterations, self.samples_per_iteration
+                else:
+                    steps = self.num_timesteps - start_steps
+                    if self._collects() and steps >= total_timesteps:
+                        break
+                    progress = steps / total_timesteps
+                    budget = min(self.samples_per_iteration, total_timesteps - steps)
+                self.exploration_rate = self._exploration(progress)
+                before = self.num_timesteps
+                record = self._iterate(budget)
+                done += 1
                 bar.set_postfix(reward=f"{record['reward']:,.0f}")
-                bar.update()
+                bar.update(self.num_timesteps - before if total_timesteps else 1)
                 callback.update_locals(locals())
                 if callback.on_step() is False:
                     break
         callback.on_training_end()
         return self
 
-    def _iterate(self):
-        """One iteration: collect (when due), targets, fit, evaluate; returns its record."""
+    def _exploration(self, progress):
+        """The probability of a random action once `progress` (0 to 1) of training is done:
+        linear from the initial to the final value over `exploration_fraction`."""
+        if progress >= self.exploration_fraction:
+            return self.exploration_final_eps
+        return self.exploration_initial_eps + (
+            self.exploration_final_eps - self.exploration_initial_eps
+        ) * progress / self.exploration_fraction
+
+    def _iterate(self, n_samples):
+        """One iteration: collect `n_samples` (when due), targets, fit, evaluate; returns its
+        record."""
         start = time.perf_counter()
         new = 0
         collect_reward = np.nan
         if self._collects():
             try:
                 batch, n_steps = self._collector.collect(
-                    self.samples_per_iteration, self._behaviour,
+                    n_samples, self._behaviour,
                     None if self.q_functions_ is None else self._q_values)
             except Exception as exc:
                 exc.add_note(f"(while FQI collected the transitions of iteration "
@@ -473,7 +539,7 @@ class FQI:
 
     def _epsilon_greedy(self, q):
         n = len(q)
-        explore = self._action_rng.random(n) < self.epsilon
+        explore = self._action_rng.random(n) < self.exploration_rate
         return np.where(explore, self._action_rng.integers(self.n_actions, size=n),
                         q.argmax(axis=1))
 
@@ -546,7 +612,7 @@ class FQI:
         state, episode_start
             Unused (the policy is reactive); accepted for stable-baselines3.
         deterministic : bool, default=True
-            Greedy actions; False draws epsilon-greedy ones.
+            Greedy actions; False draws epsilon-greedy ones (with `exploration_rate`).
 
         Returns
         -------
@@ -632,7 +698,7 @@ class FQI:
 
     def __repr__(self):
         return (f"FQI(regressor={self.regressor!r}, gamma={self.gamma}, "
-                f"epsilon={self.epsilon}, samples_per_iteration={self.samples_per_iteration}, "
+                f"samples_per_iteration={self.samples_per_iteration}, "
                 f"resample_every={self.resample_every}, keep_data={self.keep_data}, "
                 f"iteration={self.iteration})")
 

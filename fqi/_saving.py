@@ -6,7 +6,7 @@ import joblib
 
 __all__ = []
 
-_SAVE_FORMAT = 2
+_SAVE_FORMAT = 3  # 3: the exploration schedule replaced epsilon
 
 
 def _write_save(state, path):

@@ -1,5 +1,7 @@
 import os
 
+import pytest
+
 # Let scikit-learn's array-API estimator checks run instead of skipping (must precede scipy).
 os.environ.setdefault("SCIPY_ARRAY_API", "1")
 
@@ -9,8 +11,6 @@ def run_in_fork(check, timeout=60):
     hangs (say, on threads it did not inherit) is killed and fails the calling test."""
     import signal
     import time
-
-    import pytest
 
     time.sleep(0.2)  # let the parent's worker threads go idle, as they are between calls
     reader, writer = os.pipe()
@@ -41,3 +41,14 @@ def run_in_fork(check, timeout=60):
 # the estimators' defaults are measured elsewhere (tests/test_boxtrees_defaults.py).
 THESIS_TREE = dict(test_type="fixed", test_width=1.0, relative_width=False, refine_tests=False)
 THESIS_FOREST = dict(THESIS_TREE, bootstrap=False)
+
+
+
+@pytest.fixture(scope="session")
+def tiny_run(tmp_path_factory):
+    """Every default experiment of the reproduction run at the tiny budget, once for all the
+    tests (tests/benchmarks/): its output folder and report."""
+    from benchmarks.reproduce.cli import main
+
+    out = tmp_path_factory.mktemp("run_all")
+    return out, main(["--budget", "tiny", "--out", str(out), "--no-progress"])

@@ -28,8 +28,14 @@ def small_forest(**params):
                                   **params)
 
 
+# The thesis's protocol, at a small size: what these tests were written for.
+THESIS = dict(gamma=0.5, resample_every=1, keep_data=False, exploration_initial_eps=0.2,
+              exploration_final_eps=0.2)
+
+
 def small_agent(regressor=None, **params):
-    settings = dict(samples_per_iteration=1000, n_envs=50, eval_seeds=REFERENCE[:10], seed=0)
+    settings = dict(samples_per_iteration=1000, n_envs=50, eval_seeds=REFERENCE[:10], seed=0,
+                    **THESIS)
     settings.update(params)
     return FQI(small_forest() if regressor is None else regressor, ENV, **settings)
 
@@ -50,7 +56,7 @@ class ObjectCountQ(RegressorMixin, BaseEstimator):
 
 @pytest.fixture(scope="module")
 def trained():
-    return small_agent().learn(2)
+    return small_agent().learn(n_iterations=2)
 
 
 # ---------------------------------------------------------------- SB3 shape
@@ -77,11 +83,11 @@ def test_predict_accepts_every_observation_form(trained):
     assert trained.q_values(obs).shape == (6, 4) and trained.q_values(obs[0]).shape == (4,)
     assert trained.predict(np.empty((0, 3)))[0] in range(4)
     # epsilon-greedy when not deterministic: epsilon=1 gives some non-greedy actions
-    trained.epsilon = 1.0
+    trained.exploration_rate = 1.0
     try:
         explored, _ = trained.predict(np.tile(padded, (20, 1, 1)), deterministic=False)
     finally:
-        trained.epsilon = 0.2
+        trained.exploration_rate = 0.2
     assert (explored != np.tile(batch, 20)).any()
 
 
@@ -93,15 +99,15 @@ def test_callback_sees_every_iteration_and_can_stop():
         assert locals_["self"].iteration == len(seen)
         return len(seen) < 2  # stop after the second iteration
 
-    agent = small_agent(eval_episodes=0).learn(5, callback=plain)
+    agent = small_agent(eval_episodes=0).learn(n_iterations=5, callback=plain)
     assert seen == [0, 1] and agent.iteration == 2
     rewards = []
-    agent = small_agent().learn(3, callback=lambda l, g: rewards.append(l["record"]["reward"]))
+    agent = small_agent().learn(n_iterations=3, callback=lambda l, g: rewards.append(l["record"]["reward"]))
     assert rewards == [r["reward"] for r in agent.history] and len(rewards) == 3
 
 
 def test_progress_bar_and_verbose(capsys):
-    small_agent(eval_episodes=0, verbose=1).learn(2, progress_bar=True)
+    small_agent(eval_episodes=0, verbose=1).learn(n_iterations=2, progress_bar=True)
     captured = capsys.readouterr()
     assert "FQI" in captured.err and "2/2" in captured.err  # tqdm writes to stderr
     assert captured.out.count("iteration") == 2
@@ -109,8 +115,8 @@ def test_progress_bar_and_verbose(capsys):
 
 def test_csv_log_has_one_row_per_iteration(tmp_path):
     path = tmp_path / "log.csv"
-    agent = small_agent(log_path=path).learn(2)
-    agent.learn(1)  # appends, one header
+    agent = small_agent(log_path=path).learn(n_iterations=2)
+    agent.learn(n_iterations=1)  # appends, one header
     with path.open() as f:
         rows = list(csv.DictReader(f))
     assert [int(r["iteration"]) for r in rows] == [0, 1, 2]
@@ -132,7 +138,7 @@ def test_save_load_round_trip(trained, tmp_path):
     assert loaded.gamma == trained.gamma and loaded.eval_seeds == trained.eval_seeds
     assert loaded.observation_space == trained.observation_space
     assert isinstance(loaded.get_env(), envs.BatchedObjectWorld)  # from the saved id
-    loaded.learn(1)  # training continues on fresh data
+    loaded.learn(n_iterations=1)  # training continues on fresh data
     assert loaded.iteration == 3 and loaded.num_timesteps == 3000
 
 
@@ -144,12 +150,12 @@ def _without_times(history):
                                     {"resample_every": 2}],
                          ids=["re-sampling", "keeping data", "every 2"])
 def test_a_pickled_agent_learns_on_exactly_as_the_original(params):
-    agent = small_agent(**params).learn(1)
+    agent = small_agent(**params).learn(n_iterations=1)
     copy = pickle.loads(pickle.dumps(agent))
     # the transitions travel only when the next iteration still uses them
     assert (copy._data is None) == (not params)
-    agent.learn(2)
-    copy.learn(2)
+    agent.learn(n_iterations=2)
+    copy.learn(n_iterations=2)
     assert _without_times(copy.history) == _without_times(agent.history)
     worlds = envs.BatchedObjectWorld(50)
     obs, _ = worlds.reset(seed=envs.reference_worlds(50))
@@ -158,7 +164,7 @@ def test_a_pickled_agent_learns_on_exactly_as_the_original(params):
 
 def test_same_seed_same_reward_curve():
     def curve(seed):
-        return [r["reward"] for r in small_agent(seed=seed).learn(3).history]
+        return [r["reward"] for r in small_agent(seed=seed).learn(n_iterations=3).history]
 
     first = curve(7)
     assert curve(7) == first
@@ -207,20 +213,20 @@ def test_collection_reuses_q_values_as_next_state_values():
 
 def test_targets_bootstrap_through_truncation_but_not_termination():
     agent = small_agent(ObjectCountQ(weight=2.0), gamma=0.5, resample_every=None)
-    agent.learn(1)
+    agent.learn(n_iterations=1)
     first = agent.q_functions_
     np.testing.assert_array_equal(
         np.concatenate([m.y_ for m in first]),
         np.concatenate([agent._data.rewards[agent._data.actions == a] for a in range(4)]))
     # every episode here ends by truncation: all targets bootstrap
     data = agent._data
-    agent.learn(1)
+    agent.learn(n_iterations=1)
     expected = data.rewards + 0.5 * 2.0 * data.next_states.sizes
     for a, model in enumerate(agent.q_functions_):
         np.testing.assert_allclose(model.y_, expected[data.actions == a])
     # a (synthetic) termination cuts the bootstrap
     data.terminated[::3] = True
-    agent.learn(1)
+    agent.learn(n_iterations=1)
     expected = data.rewards + np.where(data.terminated, 0.0, data.next_states.sizes)
     for a, model in enumerate(agent.q_functions_):
         np.testing.assert_allclose(model.y_, expected[data.actions == a])
@@ -228,7 +234,7 @@ def test_targets_bootstrap_through_truncation_but_not_termination():
 
 def test_regimes_collect_when_they_should():
     def new_samples(**params):
-        agent = small_agent(eval_episodes=0, **params).learn(7)
+        agent = small_agent(eval_episodes=0, **params).learn(n_iterations=7)
         return [r["new_samples"] for r in agent.history], [r["n_samples"] for r in agent.history]
 
     assert new_samples(resample_every=1) == ([1000] * 7, [1000] * 7)
@@ -239,10 +245,11 @@ def test_regimes_collect_when_they_should():
 
 
 def test_missing_action_keeps_its_previous_q_function():
-    agent = small_agent(ObjectCountQ(), epsilon=0.0, eval_episodes=0).learn(1)
+    agent = small_agent(ObjectCountQ(), exploration_initial_eps=0.0,
+                        exploration_final_eps=0.0, eval_episodes=0).learn(n_iterations=1)
     # a greedy agent on an object count picks the same action everywhere
     with pytest.warns(RuntimeWarning, match="no transition with action"):
-        agent.learn(1)
+        agent.learn(n_iterations=1)
 
 
 def test_box_fqi_and_grid_ridge_beat_random():
@@ -254,7 +261,7 @@ def test_box_fqi_and_grid_ridge_beat_random():
                             ("grid", make_grid_ridge(ENV))]:
         agent = FQI(regressor, ENV, samples_per_iteration=5000, n_envs=400, eval_episodes=0,
                     seed=0)
-        scores[name] = evaluate(agent.learn(3), ENV, seeds=REFERENCE).total
+        scores[name] = evaluate(agent.learn(n_iterations=3), ENV, seeds=REFERENCE).total
     assert random_score < -80_000
     # measured (seed 0): box about +40,000, grid about -34,000, random -95,650
     assert scores["box"] > random_score + 100_000, scores
@@ -321,20 +328,21 @@ def test_thesis_run_is_unchanged():
     drawn from the same generator, and the same action draws."""
     forest = make_box_forest(ENV, n_estimators=5, n_tests=50, random_state=0)
     agent = FQI(forest, ENV, samples_per_iteration=2000, n_envs=100, eval_seeds=REFERENCE[:20],
-                seed=0).learn(3)
+                seed=0, **THESIS).learn(n_iterations=3)
     assert [r["reward"] for r in agent.history] == [-1300.0, -2400.0, -1100.0]
     assert agent.num_timesteps == 6000
     kept = FQI(make_box_forest(ENV, n_estimators=5, n_tests=50, random_state=0), ENV,
                samples_per_iteration=1000, n_envs=50, eval_seeds=REFERENCE[:10], seed=3,
-               keep_data=True, max_samples=2500).learn(4)
+               **{**THESIS, "keep_data": True}, max_samples=2500).learn(n_iterations=4)
     assert [r["reward"] for r in kept.history] == [100.0, -1200.0, 200.0, -4850.0]
 
 
 @pytest.mark.parametrize("params, error, match", [
-    ({"epsilon": -0.1}, ValueError, r"epsilon must lie in \[0.0, 1.0\]"),
-    ({"epsilon": 1.5}, ValueError, "epsilon"),
-    ({"epsilon": float("nan")}, ValueError, "epsilon"),
-    ({"epsilon": "0.2"}, TypeError, "epsilon must be a number"),
+    ({"exploration_final_eps": -0.1}, ValueError,
+     r"exploration_final_eps must lie in \[0.0, 1.0\]"),
+    ({"exploration_initial_eps": 1.5}, ValueError, "exploration_initial_eps"),
+    ({"exploration_fraction": float("nan")}, ValueError, "exploration_fraction"),
+    ({"exploration_final_eps": "0.2"}, TypeError, "exploration_final_eps must be a number"),
     ({"samples_per_iteration": 0}, ValueError, "samples_per_iteration must be >= 1"),
     ({"samples_per_iteration": 2.5}, TypeError, "samples_per_iteration must be an int"),
     ({"gamma": 1.0}, ValueError, "gamma"),
@@ -371,11 +379,11 @@ def test_predict_before_learn_and_bad_learn_arguments(tmp_path):
     with pytest.raises(NotFittedError, match="learn"):
         agent.predict(np.zeros((1, 3)))
     with pytest.raises(ValueError, match="n_iterations"):
-        agent.learn(0)
+        agent.learn(n_iterations=0)
     with pytest.raises(TypeError, match="callback"):
-        agent.learn(1, callback=3)
+        agent.learn(n_iterations=1, callback=3)
     with pytest.raises(TypeError, match="progress_bar must be a bool"):
-        agent.learn(1, progress_bar="yes")
+        agent.learn(n_iterations=1, progress_bar="yes")
 
 
 def test_log_path_is_checked_at_construction(tmp_path, monkeypatch):
@@ -405,10 +413,10 @@ def _truncated_save(agent, path):
     (lambda agent, path: joblib.dump([1, 2], path), "pickle of a list, not an agent"),
     (lambda agent, path: joblib.dump({"rules": {}}, path), "pickle of a dict, not an agent"),
     (lambda agent, path: joblib.dump({"format": 1}, path),
-     "FQI save of format version 1; this version of fqi reads version 2"),
-    (lambda agent, path: joblib.dump({"format": 2, "state": {}}, path),
-     "not an agent saved by FQI.save: it lacks action_space, env, epsilon"),
-    (lambda agent, path: joblib.dump({"format": 2, "state": [1]}, path),
+     "FQI save of format version 1; this version of fqi reads version 3"),
+    (lambda agent, path: joblib.dump({"format": 3, "state": {}}, path),
+     "not an agent saved by FQI.save: it lacks action_space, env, eval_env"),
+    (lambda agent, path: joblib.dump({"format": 3, "state": [1]}, path),
      "not an agent saved by FQI.save: it lacks state"),
 ])
 def test_load_names_the_file_and_what_is_wrong(trained, tmp_path, write, match):
@@ -460,12 +468,12 @@ def test_bad_predictions_stop_training_at_their_iteration(value):
     agent = small_agent(regressor)  # evaluates 10 worlds at iteration 0
     with pytest.raises(ValueError, match=r"non-finite Q-values \(NaN or inf\) for 10 of 10") \
             as excinfo:
-        agent.learn(3)
+        agent.learn(n_iterations=3)
     assert str(excinfo.value).startswith("iteration 0's Q-function of action 0 (ConstantQ(")
     assert agent.history == []
     agent = small_agent(regressor, eval_episodes=0)  # first predicts collecting, iteration 1
     with pytest.raises(ValueError, match="iteration 0's Q-function of action 0"):
-        agent.learn(3)
+        agent.learn(n_iterations=3)
     assert len(agent.history) == 1
 
 
@@ -557,7 +565,7 @@ def test_a_forked_child_predicts_with_threads_of_its_own():
     from sklearn.ensemble import ExtraTreesRegressor
 
     agent = FQI(ExtraTreesRegressor(n_estimators=2, random_state=0), "CartPole-v1",
-                samples_per_iteration=200, eval_episodes=0, n_jobs=2, seed=0).learn(1)
+                samples_per_iteration=200, eval_episodes=0, n_jobs=2, seed=0).learn(n_iterations=1)
     obs = np.zeros((3, 4), dtype=np.float32)
     expected = agent.q_values(obs)  # its thread pool exists before the fork
     assert run_in_fork(lambda: np.array_equal(agent.q_values(obs), expected))

@@ -1,5 +1,5 @@
 """benchmarks/bench_control.py end to end at a tiny budget: every agent's run, the JSON and
-the PNG, the exploration schedule, and the MushroomRL peer when it is installed."""
+the PNG, and the MushroomRL peer when it is installed."""
 import json
 
 import pytest
@@ -24,12 +24,6 @@ def test_tiny_run_writes_json_and_png_and_resumes(tmp_path, capsys, monkeypatch)
     monkeypatch.setattr(bench_control, "run", lambda *args: pytest.fail("retrained"))
     bench_control.main(argv)
     assert json.loads((tmp_path / "bench_control.json").read_text())["runs"] == report["runs"]
-
-
-def test_fqi_explores_on_the_tuned_dqn_schedule():
-    epsilon = bench_control.exploration("CartPole-v1", 100_000)  # 16 % of the steps, to 0.04
-    assert epsilon(0) == 1.0 and epsilon(8_000) == pytest.approx(0.52)
-    assert epsilon(16_000) == pytest.approx(0.04) and epsilon(90_000) == 0.04
 
 
 def test_bad_arguments(capsys):

@@ -114,9 +114,9 @@ def test_cartpole_learns_at_a_tiny_budget():
     random_mean = evaluate(RandomPolicy("CartPole-v1", seed=0), "CartPole-v1",
                            seeds=range(10)).mean
     agent = FQI(classic_forest(), "CartPole-v1", gamma=0.95, samples_per_iteration=1000,
-                keep_data=True, max_samples=20_000, n_envs=8, eval_episodes=0, seed=0)
-    agent.learn(8)
-    assert agent.num_timesteps >= 8000
+                resample_every=1, max_samples=20_000, n_envs=8, eval_episodes=0, seed=0)
+    agent.learn(total_timesteps=8000)
+    assert 8000 <= agent.num_timesteps < 8008 and len(agent._data) <= 8000
     score = evaluate(agent, "CartPole-v1", seeds=range(10)).mean
     assert random_mean < 30 and score > 100, (random_mean, score)  # measured: 21.3, 184
 
@@ -130,7 +130,7 @@ def test_sklearn_regressor_gets_a_feature_matrix():
             return super().fit(X, y, sample_weight)
 
     agent = FQI(Recording(n_estimators=5, random_state=0), "CartPole-v1",
-                samples_per_iteration=200, eval_episodes=2, seed=0).learn(2)
+                samples_per_iteration=200, eval_episodes=2, seed=0).learn(n_iterations=2)
     fitted = seen[1:]  # seen[0]: the check of the regressor when the env is set
     assert all(isinstance(X, np.ndarray) and X.ndim == 2 and X.shape[1] == 4 for X in fitted)
     assert sum(len(X) for X in fitted[:2]) == 200
@@ -150,7 +150,7 @@ def test_object_set_env_with_box_trees():
     forest = Recording(n_estimators=10, n_tests=50, min_samples_split=5, n_jobs=1,
                        view_bounds=(-5, 5, -5, 5))
     agent = FQI(forest, Coins, gamma=0.8, samples_per_iteration=2000, n_envs=20,
-                eval_episodes=20, seed=0).learn(4)
+                eval_episodes=20, seed=0).learn(n_iterations=4)
     assert all(isinstance(X, ObjectSets) for X in fitted)
     random_score = evaluate(RandomPolicy(Coins, seed=0), Coins, n_episodes=20).mean
     assert agent.history[-1]["mean_return"] > random_score + 0.5, (
@@ -198,7 +198,7 @@ def test_objects_of_more_attributes_learn_end_to_end():
                              n_jobs=1, random_state=0)
     assert forest.view_bounds == (-5.0, 5.0, -5.0, 5.0, -1.0, 1.0)
     agent = FQI(forest, MovingCoins, gamma=0.8, samples_per_iteration=2000, n_envs=20,
-                eval_episodes=20, seed=0).learn(4)
+                eval_episodes=20, seed=0).learn(n_iterations=4)
     random_score = evaluate(RandomPolicy(MovingCoins, seed=0), MovingCoins, n_episodes=20).mean
     assert agent.history[-1]["mean_return"] > random_score + 0.5, (
         random_score, [r["mean_return"] for r in agent.history])
@@ -285,7 +285,7 @@ def test_terminal_targets_do_not_bootstrap_truncated_ones_do():
             return np.asarray(X)[:, 2].astype(float)
 
     agent = FQI(StepQ(), countdowns(6), gamma=0.5, samples_per_iteration=300,
-                resample_every=None, eval_episodes=0, seed=1).learn(2)
+                resample_every=None, eval_episodes=0, seed=1).learn(n_iterations=2)
     data = agent._data
     ends = data.next_states[:, 2] == data.next_states[:, 3]
     assert (ends & data.terminated).any() and (ends & ~data.terminated).any()
@@ -309,20 +309,20 @@ def test_every_env_form():
         agent = FQI(classic_forest(), env, samples_per_iteration=60, eval_episodes=2, seed=0)
         assert type(agent.get_env()).__name__ == kind, name
         assert agent.get_env().num_envs == (3 if name == "vector env" else 16), name
-        agent.learn(1)
+        agent.learn(n_iterations=1)
         assert len(agent.history) == 1 and agent.num_timesteps >= 60, name
     doubled = FQI(classic_forest(), forms["wrapped env"][0], samples_per_iteration=64,
-                  eval_episodes=0, seed=0).learn(1)
+                  eval_episodes=0, seed=0).learn(n_iterations=1)
     assert set(np.unique(doubled._data.rewards)) == {2.0}  # the wrapper is kept
 
 
 @pytest.mark.parametrize("env", [Countdown(), Countdown], ids=["env made by hand", "factory"])
 def test_an_agent_on_copies_or_a_factory_pickles_and_learns_on_the_same(env):
     agent = FQI(classic_forest(random_state=0), env, samples_per_iteration=60,
-                eval_episodes=2, seed=0).learn(1)
+                eval_episodes=2, seed=0).learn(n_iterations=1)
     copy = pickle.loads(pickle.dumps(agent))
-    agent.learn(2)
-    copy.learn(2)
+    agent.learn(n_iterations=2)
+    copy.learn(n_iterations=2)
     assert [r["reward"] for r in copy.history] == [r["reward"] for r in agent.history]
     assert copy.num_timesteps == agent.num_timesteps
 
@@ -336,8 +336,8 @@ def test_a_given_vector_env_is_used_as_it_is():
     unspecced = countdowns(2)
     with pytest.raises(ValueError, match="give eval_env, or eval_episodes=0"):
         FQI(classic_forest(), unspecced)
-    FQI(classic_forest(), unspecced, samples_per_iteration=20, eval_env=Countdown).learn(1)
-    FQI(classic_forest(), unspecced, samples_per_iteration=20, eval_episodes=0).learn(1)
+    FQI(classic_forest(), unspecced, samples_per_iteration=20, eval_env=Countdown).learn(n_iterations=1)
+    FQI(classic_forest(), unspecced, samples_per_iteration=20, eval_episodes=0).learn(n_iterations=1)
 
 
 # ---------------------------------------------------------------- evaluation
@@ -345,7 +345,7 @@ def test_evaluate_fixed_seeds_in_any_batch_size():
     """One episode per seed, the same whatever the batch: in one round, in rounds of 2 (the
     last padded), or one env at a time."""
     greedy = FQI(classic_forest(), "CartPole-v1", samples_per_iteration=500, eval_episodes=0,
-                 seed=0).learn(2)
+                 seed=0).learn(n_iterations=2)
     seeds = [7, 8, 9, 10, 11]
     results = [evaluate(greedy, gym.make_vec("CartPole-v1", n, vectorization_mode="sync"),
                         seeds=seeds) for n in (5, 2)]
@@ -367,7 +367,7 @@ def test_evaluate_policy_of_stable_baselines3_on_a_box_env():
     from stable_baselines3.common.evaluation import evaluate_policy
 
     agent = FQI(classic_forest(), "CartPole-v1", samples_per_iteration=300, eval_episodes=0,
-                seed=0).learn(1)
+                seed=0).learn(n_iterations=1)
     with pytest.warns(UserWarning, match="Monitor"):
         mean, std = evaluate_policy(agent, gym.make("CartPole-v1"), n_eval_episodes=2)
     assert mean >= 8 and np.isfinite(std)
@@ -402,15 +402,15 @@ def test_stable_baselines3_callbacks_are_called_and_can_stop():
     agent = FQI(classic_forest(), "CartPole-v1", samples_per_iteration=100, eval_episodes=1,
                 seed=0)
     recorder = Recorder()
-    agent.learn(2, callback=recorder)
+    agent.learn(n_iterations=2, callback=recorder)
     assert recorder.events == ["start", "step", "step", "end"] and recorder.model is agent
     assert recorder.rewards == [r["reward"] for r in agent.history]
     assert recorder.training_env is agent.get_env()
     stopper, watcher = Recorder(stop_after=2), Recorder()
     plain = []
-    agent.learn(5, callback=CallbackList([stopper, watcher]))
+    agent.learn(n_iterations=5, callback=CallbackList([stopper, watcher]))
     assert agent.iteration == 4 and watcher.events == ["start", "step", "step", "end"]
-    agent.learn(5, callback=[watcher, lambda locals_, globals_: plain.append(1) or False])
+    agent.learn(n_iterations=5, callback=[watcher, lambda locals_, globals_: plain.append(1) or False])
     assert agent.iteration == 5 and plain == [1]
 
 
@@ -432,12 +432,12 @@ def test_stable_baselines3_eval_callback_and_logger():
                 seed=0)
     evaluation = EvalCallback(gym.make("CartPole-v1"), eval_freq=1, n_eval_episodes=2,
                               warn=False, verbose=0)
-    agent.learn(2, callback=evaluation)  # it warns that our vector env is not SB3's
+    agent.learn(n_iterations=2, callback=evaluation)  # it warns that our vector env is not SB3's
     assert evaluation.n_calls == 2 and evaluation.last_mean_reward >= 8
     assert agent.logger.name_to_value == {}  # dumped after each iteration, and by the callback
     written = Written()
     agent.set_logger(Logger(None, [written]))
-    agent.learn(1, callback=EvalCallback(gym.make("CartPole-v1"), eval_freq=1,
+    agent.learn(n_iterations=1, callback=EvalCallback(gym.make("CartPole-v1"), eval_freq=1,
                                          n_eval_episodes=2, warn=False, verbose=0))
     (step, values), (eval_step, eval_values) = written.dumps
     assert step == eval_step == agent.num_timesteps
@@ -486,12 +486,13 @@ def test_evaluate_and_a_failed_set_env_close_the_envs_they_build_and_no_other():
     with pytest.raises(RuntimeError, match="step"):
         agent.set_env(ClosingBroken)  # builds 2 training + 2 evaluation envs, then fails
     assert Closing.closed == 7 and agent.get_env() is given and not given.closed
-    agent.learn(1)
+    agent.learn(n_iterations=1)
 
 
 def test_save_load_round_trip_on_a_box_env(tmp_path):
     agent = FQI(classic_forest(), "CartPole-v1", gamma=0.9, samples_per_iteration=200,
-                keep_data=True, max_samples=1000, n_envs=4, eval_episodes=2, seed=3).learn(2)
+                resample_every=1, max_samples=1000, n_envs=4, eval_episodes=2,
+                seed=3).learn(n_iterations=2)
     agent.save(tmp_path / "agent.joblib")
     loaded = FQI.load(tmp_path / "agent.joblib")
     for name in FQI._param_names():  # every constructor parameter, with no list kept by hand
@@ -500,21 +501,21 @@ def test_save_load_round_trip_on_a_box_env(tmp_path):
     np.testing.assert_array_equal(loaded.q_values(obs), agent.q_values(obs))
     assert loaded.history == agent.history and loaded.get_env() is not None  # the id
     agent.set_env("CartPole-v1")  # new episodes, as the loaded agent starts
-    agent.learn(1)
-    loaded.learn(1)  # the same random streams: the same next iteration
+    agent.learn(n_iterations=1)
+    loaded.learn(n_iterations=1)  # the same random streams: the same next iteration
     assert loaded.history[-1]["reward"] == agent.history[-1]["reward"]
     np.testing.assert_array_equal(loaded.q_values(obs), agent.q_values(obs))
 
     countdown = FQI(classic_forest(), Countdown, samples_per_iteration=50,
-                    eval_episodes=0).learn(1)
+                    eval_episodes=0).learn(n_iterations=1)
     countdown.save(tmp_path / "countdown.joblib")
     offline = FQI.load(tmp_path / "countdown.joblib", n_jobs=1)
     assert offline.get_env() is None and offline.n_jobs == 1
     assert offline.predict(np.zeros(4, dtype=np.float32))[0] in (0, 1)
     with pytest.raises(ValueError, match="no env"):
-        offline.learn(1)
+        offline.learn(n_iterations=1)
     offline.set_env(Countdown)
-    offline.learn(1)
+    offline.learn(n_iterations=1)
     with pytest.raises(ValueError, match="spaces"):
         FQI.load(tmp_path / "countdown.joblib", env="CartPole-v1")
     with pytest.raises(TypeError, match=r"unknown parameters \['gama'\]"):
@@ -576,7 +577,7 @@ def test_an_env_that_fails_later_is_named_with_the_iteration():
     agent = FQI(classic_forest(), LateFailure, samples_per_iteration=500, n_envs=2,
                 eval_episodes=0)
     with pytest.raises(RuntimeError, match="the simulator crashed") as excinfo:
-        agent.learn(3)
+        agent.learn(n_iterations=3)
     assert "while FQI collected the transitions of iteration 0" in excinfo.value.__notes__[0]
 
 

@@ -16,6 +16,7 @@ __all__ = ["GAMMA", "ForestSettings", "AgentSettings", "make_env", "reference_se
 # in the measured comparison of docs/fqi.md, "Discount factor"). Pinned here so a changed
 # library default cannot silently change cached results.
 GAMMA = 0.5
+THESIS_EPSILON = 0.2  # the thesis's exploration, the same throughout (after a random round)
 _MODELS = ("box", "grid")
 
 
@@ -83,9 +84,10 @@ def _capped(value, cap):
 
 
 def make_agent(settings, budget, seed, samples):
-    """The FQI agent of a registry setting on the game: up to 400 training worlds in
-    lockstep (the game's batched engine, through its vector entry point), evaluated on the
-    reference worlds.
+    """The FQI agent of a registry setting on the game, with the thesis's protocol: up to
+    400 training worlds in lockstep (the game's batched engine, through its vector entry
+    point), epsilon 0.2, evaluated on the reference worlds after every iteration; learn it
+    with ``learn(n_iterations=...)``.
 
     Parameters
     ----------
@@ -105,6 +107,7 @@ def make_agent(settings, budget, seed, samples):
                samples_per_iteration=samples, resample_every=settings.resample_every,
                keep_data=settings.keep_data,
                max_samples=max(settings.max_samples or samples, samples),
+               exploration_initial_eps=THESIS_EPSILON, exploration_final_eps=THESIS_EPSILON,
                n_envs=min(400, samples), eval_seeds=reference_seeds(env, budget), seed=seed)
 
 

@@ -30,7 +30,7 @@ class Attention(UnitKind):
     def run(self, unit, checkpoint=None):
         settings, budget = unit.settings, unit.budget
         agent = make_agent(settings, budget, unit.seed, unit.samples).learn(
-            budget.attention_iterations)
+            n_iterations=budget.attention_iterations)
         n_types = make_env(settings).unwrapped.n_types
         world_seed, observation = _busy_reference_view(settings)
         actions = []

@@ -40,7 +40,7 @@ class FittedQ(UnitKind):
                                  "seconds": earlier + time.perf_counter() - start})
 
         if agent.iteration < budget.iterations:
-            agent.learn(budget.iterations - agent.iteration,
+            agent.learn(n_iterations=budget.iterations - agent.iteration,
                         callback=None if checkpoint is None else save)
         env = make_env(unit.settings)
         random_reward = evaluate(RandomPolicy(env, seed=unit.seed), env,

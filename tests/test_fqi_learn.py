@@ -1,0 +1,115 @@
+"""`FQI.learn` in stable-baselines3's shape: exact step counts, collection rounds with several
+backups each, the exploration schedule, and the defaults learning on a small Box env and a
+small object-set env."""
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium import spaces
+from sklearn.ensemble import ExtraTreesRegressor
+
+from boxtrees import BoxExtraTreesRegressor
+from fqi import FQI, RandomPolicy, evaluate
+
+
+def cartpole_agent(**params):
+    settings = dict(n_envs=1, samples_per_iteration=300, resample_every=2, eval_episodes=0,
+                    seed=0)
+    return FQI(ExtraTreesRegressor(n_estimators=5, random_state=0), "CartPole-v1",
+               **{**settings, **params})
+
+
+def test_total_timesteps_counts_every_transition_in_rounds_with_their_backups():
+    agent = cartpole_agent().learn(total_timesteps=1000)
+    assert agent.num_timesteps == 1000
+    # rounds of 300 steps (the last one 100), each followed by 2 backups on all data kept
+    assert [r["new_samples"] for r in agent.history] == [300, 0, 300, 0, 300, 0, 100, 0]
+    assert [r["n_samples"] for r in agent.history] == [300, 300, 600, 600, 900, 900, 1000,
+                                                       1000]
+    assert agent.learn(total_timesteps=500).num_timesteps == 1500  # continues
+    several = cartpole_agent(n_envs=4).learn(total_timesteps=1000)
+    # the envs step together: a round's last step may go past its count (counted, not kept)
+    assert 1000 <= several.num_timesteps < 1004
+    assert several.num_timesteps - 4 * 4 < several.history[-1]["n_samples"] <= 1000
+
+
+def test_the_buffer_keeps_the_latest_transitions():
+    agent = cartpole_agent(max_samples=700).learn(total_timesteps=1200)
+    assert [r["n_samples"] for r in agent.history][-2:] == [700, 700]
+    replaced = cartpole_agent(keep_data=False).learn(total_timesteps=900)
+    assert {r["n_samples"] for r in replaced.history} == {300}
+
+
+def test_exploration_falls_as_in_stable_baselines3s_dqn():
+    rates = []
+    agent = cartpole_agent(samples_per_iteration=250, resample_every=1,
+                           exploration_fraction=0.5, exploration_initial_eps=1.0,
+                           exploration_final_eps=0.1)
+    agent.learn(total_timesteps=1000,
+                callback=lambda locals_, globals_: rates.append(locals_["self"].exploration_rate))
+    # set before each round from the share of the steps done: 0, 1/4, 1/2, 3/4
+    assert rates == pytest.approx([1.0, 0.55, 0.1, 0.1])
+    thesis = cartpole_agent(exploration_initial_eps=0.2, exploration_final_eps=0.2)
+    thesis.learn(n_iterations=4, callback=lambda l, g: rates.append(l["self"].exploration_rate))
+    assert rates[4:] == [0.2] * 4
+
+
+def test_the_defaults_learn_cartpole_from_its_feature_vector():
+    agent = FQI(ExtraTreesRegressor(n_estimators=10, min_samples_split=10, random_state=0),
+                "CartPole-v1", eval_episodes=0, seed=0).learn(total_timesteps=7_500)
+    random = evaluate(RandomPolicy("CartPole-v1", seed=0), "CartPole-v1", n_episodes=10).mean
+    learned = evaluate(agent, "CartPole-v1", n_episodes=10).mean
+    assert random < 30 and learned > 150, (random, learned)  # measured: 22.0, 249.9
+
+
+class NearestType(gym.Env):
+    """Up to 5 objects ``[x, y, type]`` (types 0-2) in ``[-5, 5]^2``; the reward is 1 when
+    the action names the type of the object nearest the origin. Episodes of 10 steps."""
+
+    observation_space = spaces.Sequence(spaces.Box(np.array([-5, -5, 0], dtype=np.float32),
+                                                   np.array([5, 5, 2], dtype=np.float32)),
+                                        stack=True)
+    action_space = spaces.Discrete(3)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.t = 0
+        return self._draw(), {}
+
+    def _draw(self):
+        n = int(self.np_random.integers(1, 6))
+        self.objects = np.column_stack([self.np_random.uniform(-5, 5, (n, 2)),
+                                        self.np_random.integers(0, 3, n)]).astype(np.float32)
+        return self.objects
+
+    def step(self, action):
+        nearest = self.objects[np.argmin(np.abs(self.objects[:, :2]).max(axis=1)), 2]
+        reward = float(action == nearest)
+        self.t += 1
+        return self._draw(), reward, False, self.t == 10, {}
+
+
+def test_the_defaults_learn_an_object_set_env():
+    agent = FQI(BoxExtraTreesRegressor(n_estimators=10, random_state=0), NearestType,
+                eval_episodes=0, seed=0).learn(total_timesteps=5_000)
+    seeds = range(50)
+    random = evaluate(RandomPolicy(NearestType(), seed=0), NearestType, seeds=seeds).mean
+    learned = evaluate(agent, NearestType, seeds=seeds).mean
+    assert random < 4.5 and learned > 8, (random, learned)  # of 10; measured: 3.36, 9.3
+
+
+@pytest.mark.parametrize("call, error, match", [
+    (lambda agent: agent.learn(), TypeError, "total_timesteps or n_iterations"),
+    (lambda agent: agent.learn(100, n_iterations=2), TypeError, "one of them"),
+    (lambda agent: agent.learn(total_timesteps=0), ValueError, "total_timesteps must be >= 1"),
+])
+def test_learn_takes_steps_or_iterations(call, error, match):
+    with pytest.raises(error, match=match):
+        call(cartpole_agent())
+
+
+def test_offline_data_is_learned_by_iterations():
+    agent = cartpole_agent(resample_every=None)
+    with pytest.raises(ValueError, match="learn\\(n_iterations=...\\)"):
+        agent.learn(total_timesteps=100)
+    agent.learn(n_iterations=3)
+    assert [r["new_samples"] for r in agent.history] == [300, 0, 0]
