@@ -16,6 +16,7 @@ from ._callbacks import _as_callback
 from ._checks import (_check_bool, _check_int, _check_n_jobs, _check_real, _check_seed,
                       _check_verbose)
 from ._collect import _checked_step, _Collector, _Transitions
+from ._datasets import _dataset_transitions
 from ._envs import _check_env, _close_built, _copy_vector, _make_vector, _n_actions
 from ._evaluate import _eval_seeds, evaluate
 from ._logger import CSVLogger, _KeyValueLogger
@@ -416,13 +417,63 @@ class FQI:
                                  "sets how many iterations run on that data")
         else:
             n_iterations = _check_int("n_iterations", n_iterations, 1)
-        callback = _as_callback(callback)
-        progress_bar = _check_bool("progress_bar", progress_bar)
         if self._env is None:
             raise ValueError("this agent has no env (it was loaded without one): pass env to "
                              "FQI.load or call set_env(env)")
         if self._collector is None:
             self._collector = _Collector(self._env, self._observations, self._world_rng)
+        return self._train(callback, progress_bar, total_timesteps, n_iterations)
+
+    def learn_offline(self, dataset, n_iterations, callback=None, progress_bar=False):
+        """Fitted Q-iteration on a fixed data set, without playing the env: FQI as first
+        formulated, and as offline reinforcement learning works.
+
+        The data set replaces the agent's transitions; `n_iterations` backups follow, each
+        logged and evaluated as in `learn` (``eval_episodes=0`` plays nothing). A later
+        `learn` goes on online: with `keep_data`, its transitions join the data set.
+
+        Parameters
+        ----------
+        dataset : mapping or minari.MinariDataset
+            A mapping of one entry per transition: ``observations`` and
+            ``next_observations`` (an array of the observation space's shape per row, or
+            for object sets a list of ``(n_i, d + 1)`` arrays or a `boxtrees.ObjectSets`),
+            ``actions`` (ints), ``rewards``, ``terminations`` (bools; no bootstrap after
+            one) and optionally ``truncations`` (bootstrapped through, as online). Or a
+            Minari dataset (its episodes; its spaces must be the agent's).
+        n_iterations : int
+        callback, progress_bar
+            As in `learn`.
+
+        Returns
+        -------
+        self : FQI
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from sklearn.ensemble import ExtraTreesRegressor
+        >>> from fqi import FQI
+        >>> rng = np.random.default_rng(0)
+        >>> x = rng.uniform(-2.4, 2.4, size=(500, 4)).astype(np.float32)
+        >>> data = {"observations": x, "actions": rng.integers(0, 2, 500),
+        ...         "rewards": np.ones(500), "next_observations": x,
+        ...         "terminations": np.abs(x[:, 0]) > 2}
+        >>> agent = FQI(ExtraTreesRegressor(n_estimators=5, random_state=0), "CartPole-v1",
+        ...             eval_episodes=0, seed=0).learn_offline(data, n_iterations=3)
+        >>> len(agent.history), agent.num_timesteps
+        (3, 0)
+        """
+        n_iterations = _check_int("n_iterations", n_iterations, 1)
+        self._data = _dataset_transitions(dataset, self._observations, self.observation_space,
+                                          self.action_space)
+        return self._train(callback, progress_bar, None, n_iterations, collect=False)
+
+    def _train(self, callback, progress_bar, total_timesteps, n_iterations, collect=True):
+        """The iterations of `learn` (collecting when due, if `collect`) and `learn_offline`,
+        with the callbacks and the progress bar."""
+        callback = _as_callback(callback)
+        progress_bar = _check_bool("progress_bar", progress_bar)
         callback.init_callback(self)
         callback.on_training_start(locals(), globals())
         start_steps, done = self.num_timesteps, 0
@@ -441,7 +492,7 @@ class FQI:
                     budget = min(self.samples_per_iteration, total_timesteps - steps)
                 self.exploration_rate = self._exploration(progress)
                 before = self.num_timesteps
-                record = self._iterate(budget)
+                record = self._iterate(budget if collect else 0)
                 done += 1
                 bar.set_postfix(reward=f"{record['reward']:,.0f}")
                 bar.update(self.num_timesteps - before if total_timesteps else 1)
@@ -461,12 +512,12 @@ class FQI:
         ) * progress / self.exploration_fraction
 
     def _iterate(self, n_samples):
-        """One iteration: collect `n_samples` (when due), targets, fit, evaluate; returns its
-        record."""
+        """One iteration: collect `n_samples` (when due; none offline), targets, fit,
+        evaluate; returns its record."""
         start = time.perf_counter()
         new = 0
         collect_reward = np.nan
-        if self._collects():
+        if n_samples and self._collects():
             try:
                 batch, n_steps = self._collector.collect(
                     n_samples, self._behaviour,
