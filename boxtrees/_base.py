@@ -378,7 +378,7 @@ class RegressionTargets(RegressorMixin):
 
         Returns
         -------
-        y : ndarray of shape (n_samples,) or (n_samples, n_outputs_)
+        y : ndarray of shape (n_samples,) or (n_samples, ``n_outputs_``)
         """
         values = self._predict_mean(X, getattr(self, "n_jobs", None))
         return values[:, 0] if self.n_outputs_ == 1 else values
@@ -435,7 +435,7 @@ class ClassificationTargets(ClassifierMixin):
 
         Returns
         -------
-        proba : ndarray of shape (n_samples, n_classes_), or a list of them per output
+        proba : ndarray of shape (n_samples, ``n_classes_``), or a list of them per output
             Columns in the order of ``classes_``.
         """
         blocks = self._per_output(self._predict_mean(X, getattr(self, "n_jobs", None)))
@@ -452,7 +452,7 @@ class ClassificationTargets(ClassifierMixin):
 
         Returns
         -------
-        y : ndarray of shape (n_samples,) or (n_samples, n_outputs_)
+        y : ndarray of shape (n_samples,) or (n_samples, ``n_outputs_``)
         """
         return self._most_probable(self.predict_proba(X))
 

@@ -129,7 +129,7 @@ class _SingleTree(BaseBoxTrees):
     @property
     def feature_importances_(self):
         """Impurity-based importance of each type of ``types_`` (each column for a feature
-        matrix), summing to 1 (all zeros for a single leaf), shape (n_types_,)."""
+        matrix), summing to 1 (all zeros for a single leaf), shape (``n_types_``,)."""
         check_is_fitted(self)
         return self.tree_.type_importances(self.types_)
 

@@ -265,7 +265,7 @@ class _Forest(BaseBoxTrees):
 
         Returns
         -------
-        importances : ndarray of shape (n_types_,)
+        importances : ndarray of shape (``n_types_``,)
         """
         check_is_fitted(self)
         total = np.mean([t.type_importances(self.types_) for t in self._trees()], axis=0)
@@ -406,7 +406,7 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         Number of attributes ``d`` of the objects seen at fit (1 for a feature matrix).
     column_groups_ : tuple of tuple of int
         The column groups the tests draw from.
-    bounds_ : ndarray of shape (n_types_, 2 * n_attributes_)
+    bounds_ : ndarray of shape (``n_types_``, 2 * ``n_attributes_``)
         Sampling region per type of ``types_``, ``(low, high)`` per attribute.
     n_features_in_ : int
         Number of columns, when fitted on a feature matrix.
@@ -492,7 +492,7 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
     n_outputs_ : int
     types_, n_types_, type_names_, n_attributes_, column_groups_, bounds_, n_features_in_, feature_names_in_, oob_score_
         As in `BoxExtraTreesRegressor`.
-    oob_decision_function_ : ndarray of shape (n_samples, n_classes_), or a list of them per output
+    oob_decision_function_ : ndarray of shape (n_samples, ``n_classes_``), or a list of them per output
         Each training sample's class probabilities by the trees whose bootstrap sample left
         it out (NaN when none did), as `predict_proba` gives them, with ``oob_score``.
 

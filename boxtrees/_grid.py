@@ -53,7 +53,7 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         Number of attributes of the objects seen at fit (1 for a feature matrix).
     columns_ : tuple of int
         The attributes the grid lies over.
-    bounds_ : ndarray of shape (n_types_, 4)
+    bounds_ : ndarray of shape (``n_types_``, 4)
         Grid extent used for each type, ``(xmin, xmax, ymin, ymax)`` over ``columns_``.
     n_features_in_ : int
         Number of columns, when fitted on a feature matrix.
@@ -139,7 +139,7 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
 
         Returns
         -------
-        counts : ndarray of shape (n_samples, n_bins * n_bins * n_types_)
+        counts : ndarray of shape (n_samples, n_bins * n_bins * ``n_types_``)
             (``n_bins * n_features`` for a feature matrix.)
         """
         check_is_fitted(self)
