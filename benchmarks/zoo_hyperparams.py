@@ -1,14 +1,15 @@
-"""rl-zoo3's tuned DQN hyperparameters, the one copy the benchmarks share.
+"""rl-zoo3's tuned DQN and PPO hyperparameters, the one copy the benchmarks share.
 
-From rl-zoo3 2.9.2, ``rl_zoo3/hyperparams/dqn.yml`` (policy ``"MlpPolicy"``; its
-``n_timesteps`` is left to each user, which sets its own budget): `bench_control.py` trains
-DQN with them as they are, and the baselines' searches of `benchmarks/reproduce/registry.py`
-start from them with their own discount factors; `SMALL_TASK_DQN` adapts LunarLander-v2's to the
-game (the ``dqn`` unit kind trains with it, and the searches start from it).
+From rl-zoo3 2.9.2, ``rl_zoo3/hyperparams/dqn.yml`` and ``ppo.yml`` (policy ``"MlpPolicy"``;
+their ``n_timesteps`` in `ZOO_STEPS`; PPO's linear schedules of CartPole-v1 as constants):
+`bench_control.py` and the registry's ``control_*`` experiments train with them as they are,
+and the baselines' searches of `benchmarks/reproduce/registry.py` start from them with their
+own discount factors; `SMALL_TASK_DQN` adapts LunarLander-v2's DQN settings to the game (the
+``dqn`` unit kind trains with it, and the searches start from it).
 """
 import copy
 
-__all__ = ["ZOO_DQN", "SMALL_TASK_DQN", "without_gamma"]
+__all__ = ["ZOO_DQN", "ZOO_PPO", "ZOO_STEPS", "SMALL_TASK_DQN", "without_gamma"]
 
 _LUNARLANDER = {
     "learning_rate": 6.3e-4, "batch_size": 128, "buffer_size": 50_000,
@@ -34,10 +35,29 @@ ZOO_DQN = {
 }
 
 
-def without_gamma(env_id):
-    """The settings of `env_id` less the discount factor, for a caller that sets its own
-    (a new dict, in the same order)."""
-    return {key: value for key, value in ZOO_DQN[env_id].items() if key != "gamma"}
+ZOO_PPO = {
+    "CartPole-v1": {"n_envs": 8, "n_steps": 32, "batch_size": 256, "gae_lambda": 0.8,
+                    "gamma": 0.98, "n_epochs": 20, "ent_coef": 0.0, "learning_rate": 1e-3,
+                    "clip_range": 0.2},
+    "LunarLander-v2": {"n_envs": 16, "n_steps": 1024, "batch_size": 64, "gae_lambda": 0.98,
+                       "gamma": 0.999, "n_epochs": 4, "ent_coef": 0.01},
+    "MountainCar-v0": {"normalize": True, "n_envs": 16, "n_steps": 16, "gae_lambda": 0.98,
+                       "gamma": 0.99, "n_epochs": 4, "ent_coef": 0.0},
+    "Acrobot-v1": {"normalize": True, "n_envs": 16, "n_steps": 256, "gae_lambda": 0.94,
+                   "gamma": 0.99, "n_epochs": 4, "ent_coef": 0.0},
+}
+# rl-zoo3's training budgets (environment steps)
+ZOO_STEPS = {
+    "DQN": {"CartPole-v1": 50_000, "Acrobot-v1": 100_000, "MountainCar-v0": 120_000},
+    "PPO": {"CartPole-v1": 100_000, "Acrobot-v1": 1_000_000, "MountainCar-v0": 1_000_000},
+}
+
+
+def without_gamma(env_id, table=None):
+    """The settings of `env_id` in `table` (default: `ZOO_DQN`) less the discount factor,
+    for a caller that sets its own (a new dict, in the same order)."""
+    table = ZOO_DQN if table is None else table
+    return {key: value for key, value in table[env_id].items() if key != "gamma"}
 
 
 # rl-zoo3's LunarLander-v2 settings for 400,000 steps of the game, less its discount factor:

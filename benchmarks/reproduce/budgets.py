@@ -37,6 +37,9 @@ class Budget:
         FQI iterations of the run whose Q-forest the attention figure draws.
     max_trees, max_tests : int or None
         Caps on the forests' M and K (None: the thesis's values).
+    control_scale : float, default=1.0
+        Multiplies the environment steps of the runs on gymnasium's tasks (``control``
+        units), whose settings give them at full size.
     overrides : dict of str to dict
         Experiment name -> parameters replacing its settings' at this budget (applied to
         every setting of the experiment alike, so its comparison stays fair).
@@ -53,6 +56,7 @@ class Budget:
     attention_iterations: int = 3
     max_trees: int = None
     max_tests: int = None
+    control_scale: float = 1.0
     overrides: dict = field(default_factory=dict)
 
     @property
@@ -74,10 +78,11 @@ BUDGETS = {
     # views get smaller forests.
     "quick": Budget("quick", seeds=2, iterations=_QUICK_ITERATIONS, samples=2_000,
                     eval_steps=8_000, rmse_samples=5_000, rmse_folds=3, attention_iterations=3,
+                    control_scale=0.2,
                     overrides={"treasure": {"n_estimators": 10, "n_tests": 200},
                                "baselines": {"checkpoints": _QUICK_ITERATIONS}}),
     # for the tests: every experiment end to end in seconds
     "tiny": Budget("tiny", seeds=1, iterations=2, samples=200, eval_steps=50,
                    rmse_samples=200, rmse_folds=2, dqn_steps=100, attention_iterations=1,
-                   max_trees=2, max_tests=10),
+                   max_trees=2, max_tests=10, control_scale=0.01),
 }

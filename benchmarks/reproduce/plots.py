@@ -100,11 +100,12 @@ def reward_bars(experiment, stats, budget):
     return fig
 
 
-def versus_steps(experiment, stats, curves, budget):
+def versus_steps(experiment, stats, curves, budget, ylabel="reward per 20,000 greedy steps",
+                 threshold=None):
     """Reward against environment steps, mean +- 1 sd over runs (`curves`: label ->
     ``(steps, mean, sd)`` of its kind's ``curve``: FQI after each iteration, the random
     policy at 0; the baselines at their checkpoints); settings without a curve (reference
-    policies) as horizontal lines."""
+    policies) as horizontal lines, and a `threshold` (a task's "solved") dotted."""
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
     references = 0
     for label, s in stats.items():
@@ -120,10 +121,14 @@ def versus_steps(experiment, stats, curves, budget):
                 f"{s.seconds / 60:.0f} min/run)")
         ax.fill_between(x, mean - sd, mean + sd, alpha=0.2)
     ax.axhline(0, color="grey", lw=0.6)
+    if threshold is not None:
+        ax.axhline(threshold, color="black", ls=":", lw=1.0)
+        ax.annotate(f"solved ({threshold:,.0f})", (0, threshold), xytext=(2, 3),
+                    textcoords="offset points", fontsize=7)
     ax.set_xlabel("environment steps")
     ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
     ax.yaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
-    ax.set_ylabel("reward per 20,000 greedy steps")
+    ax.set_ylabel(ylabel)
     ax.set_title(_title(experiment, budget, stats), fontsize=10)
     ax.legend(fontsize=7, loc="lower right", title="method (final score, wall time)",
               title_fontsize=7)

@@ -9,7 +9,7 @@ beside ours.
 """
 from dataclasses import dataclass, field, replace
 
-from ..zoo_hyperparams import SMALL_TASK_DQN, without_gamma
+from ..zoo_hyperparams import SMALL_TASK_DQN, ZOO_DQN, ZOO_PPO, ZOO_STEPS, without_gamma
 from .budgets import BUDGETS
 from .findings import (AtLeast, Falls, Faster, HighestPeak, MoreStable, NearRandom, Ranking,
                        Sign, Similar)
@@ -282,16 +282,10 @@ _DQN_SEARCH = {
     "CartPole, gamma 0.99": {**_ZOO_DQN_CARTPOLE, "gamma": 0.99},
     "MountainCar, gamma 0.9": {**_ZOO_DQN_MOUNTAINCAR, "gamma": 0.9},
 }
-_ZOO_PPO = {  # LunarLander-v2
-    "n_envs": 16, "n_steps": 1024, "batch_size": 64, "gae_lambda": 0.98, "n_epochs": 4,
-    "ent_coef": 0.01}
-_ZOO_PPO_CARTPOLE = {
-    "n_envs": 8, "n_steps": 32, "batch_size": 256, "gae_lambda": 0.8, "n_epochs": 20,
-    "ent_coef": 0.0, "learning_rate": 1e-3, "clip_range": 0.2}
-_ZOO_PPO_MOUNTAINCAR = {  # both normalize rewards
-    "normalize": True, "n_envs": 16, "n_steps": 16, "gae_lambda": 0.98, "n_epochs": 4,
-    "ent_coef": 0.0}
-_ZOO_PPO_ACROBOT = {**_ZOO_PPO_MOUNTAINCAR, "n_steps": 256, "gae_lambda": 0.94}
+_ZOO_PPO = without_gamma("LunarLander-v2", ZOO_PPO)
+_ZOO_PPO_CARTPOLE = without_gamma("CartPole-v1", ZOO_PPO)
+_ZOO_PPO_MOUNTAINCAR = without_gamma("MountainCar-v0", ZOO_PPO)  # both normalize rewards
+_ZOO_PPO_ACROBOT = without_gamma("Acrobot-v1", ZOO_PPO)
 _CARTPOLE_NORMALIZED = {**_ZOO_PPO_CARTPOLE, "normalize": True}
 _PPO_SEARCH = {
     "LunarLander, gamma 0.9": {**_ZOO_PPO, "gamma": 0.9},
@@ -535,6 +529,50 @@ EXPERIMENTS += (
               "train with one torch thread each, FQI's forests on every core (wall "
               "times are per run). Scores: FQI the mean of its last 5 iterations, the "
               "baselines their final policy."),
+)
+
+# FQI on gymnasium's tasks, with the library's defaults and nothing tuned per task, against
+# rl-zoo3's tuned DQN and PPO at their own budgets (on demand: ``--only control_cartpole``).
+_CONTROL = {"CartPole-v1": 475.0, "Acrobot-v1": -100.0, "MountainCar-v0": -110.0}
+
+
+def _control(env_id):
+    steps = ZOO_STEPS["DQN"][env_id]
+    return Experiment(
+        f"control_{env_id.split('-')[0].lower()}", "extra",
+        f"{env_id}: FQI with its defaults against tuned DQN and PPO", "control",
+        env_id=env_id, on_demand=True, defaults={"threshold": _CONTROL[env_id]},
+        settings={
+            "FQI, Extra-Trees": {"learner": "fqi", "steps": steps},
+            "FQI, boxtrees classic": {"learner": "fqi", "regressor": "box-classic",
+                                      "steps": steps},
+            "DQN (rl-zoo3)": {"learner": "DQN", "hyperparams": ZOO_DQN[env_id],
+                              "steps": steps},
+            "PPO (rl-zoo3)": {"learner": "PPO", "hyperparams": ZOO_PPO[env_id],
+                              "steps": ZOO_STEPS["PPO"][env_id]}},
+        notes=f"Mean return on 20 held-out episodes every 5,000 steps. FQI: `fqi.FQI`'s "
+              f"defaults with 30 Extra-Trees (scikit-learn's, or boxtrees' classic splits) "
+              f"for rl-zoo3's DQN budget ({steps:,} steps); DQN and PPO: rl-zoo3's tuned "
+              f"settings and budgets; one core per run.")
+
+
+# The defaults of FQI, measured: variations of one setting at a time on CartPole-v1.
+_FQI_VARIANTS = {
+    "defaults": {},
+    "10 backups per round": {"resample_every": 10},
+    "rounds of 1,000 steps": {"samples_per_iteration": 1000, "resample_every": 2},
+    "epsilon to 0.2": {"exploration_final_eps": 0.2},
+    "gamma 0.98": {"gamma": 0.98},
+    "new data only (thesis)": {"keep_data": False, "resample_every": 1},
+}
+EXPERIMENTS += (
+    *(_control(env_id) for env_id in _CONTROL),
+    Experiment(
+        "fqi_defaults", "extra", "CartPole-v1: FQI's defaults, one change at a time",
+        "control", env_id="CartPole-v1", on_demand=True, seeds=3,
+        defaults={"learner": "fqi", "steps": 50_000, "threshold": 475.0},
+        settings={label: {"fqi": fqi} for label, fqi in _FQI_VARIANTS.items()},
+        notes="30 Extra-Trees (n_min 10); the evidence for `fqi.FQI`'s defaults."),
 )
 
 REGISTRY = {experiment.name: experiment for experiment in EXPERIMENTS}

@@ -168,3 +168,18 @@ def test_a_kind_is_one_class_that_registers_itself(tmp_path):
         assert stats.score == 7.0 and stats.n_runs == 1
     finally:
         del KINDS["constant"]
+
+
+def test_gymnasium_tasks_run_each_learner_and_report_its_steps_to_the_threshold(tmp_path):
+    report = main(["--budget", "tiny", "--only", "control_cartpole", "--out", str(tmp_path),
+                   "--no-progress"]).read_text()
+    experiment = REGISTRY["control_cartpole"]
+    for label in experiment.settings:
+        result = json.loads(unit_path(tmp_path, TINY, "control_cartpole", label,
+                                      0).read_text())["result"]
+        steps = [s for s, _ in result["curve"]]
+        assert steps == sorted(steps) and steps[-1] == result["total_timesteps"]
+        assert result["curve"][-1][1] == result["reward"] and result["train_seconds"] > 0
+        assert steps[-1] >= round(experiment.params(label)["steps"] * TINY.control_scale)
+    assert "| FQI, Extra-Trees | 1 |" in report and "runs solved" in report
+    assert (tmp_path / "extra_control_cartpole.png").stat().st_size > 5000

@@ -1,0 +1,126 @@
+"""``control``: a learner on a gymnasium task (classic control and any other registered id):
+FQI with the library's defaults, or a stable-baselines3 algorithm with tuned settings,
+scored on held-out episodes every few thousand steps."""
+from dataclasses import dataclass, field
+
+import gymnasium as gym
+import numpy as np
+from sklearn.ensemble import ExtraTreesRegressor
+
+from fqi import FQI, make_box_forest
+
+from .. import plots
+from ..cache import ListOf
+from ._base import UnitKind, fmt
+
+__all__ = ["Control", "REGRESSORS"]
+
+# The Extra-Trees of the FQI agents: 30 trees, nodes of fewer than 10 samples are leaves,
+# one job (so that every learner gets one core).
+REGRESSORS = {
+    "extra-trees": lambda: ExtraTreesRegressor(n_estimators=30, min_samples_split=10,
+                                               n_jobs=1),
+    "box-classic": lambda: make_box_forest(test_type="classic", n_estimators=30, n_tests=10,
+                                           min_samples_split=10, n_jobs=1),
+}
+_SECONDS_PER_STEP = 2.5e-3  # FQI's defaults on CartPole-v1, one core (measured)
+
+
+@dataclass(frozen=True)
+class ControlSettings:
+    """``env_id`` (a registered gymnasium id), ``learner`` ("fqi", "DQN" or "PPO"),
+    ``steps`` (environment steps at full size), for FQI its ``regressor`` (a name of
+    `REGRESSORS`) and ``fqi`` (`fqi.FQI` arguments other than its defaults), for SB3 its
+    ``hyperparams`` (rl-zoo3's form, `training.train_sb3`); the evaluation: ``eval_episodes``
+    held-out episodes every ``eval_every`` steps; ``threshold``: the task's solved score."""
+
+    env_id: str
+    learner: str = None
+    steps: int = None
+    regressor: str = "extra-trees"
+    fqi: dict = field(default_factory=dict)
+    hyperparams: dict = field(default_factory=dict)
+    eval_every: int = 5000
+    eval_episodes: int = 20
+    threshold: float = None
+
+    def __post_init__(self):
+        if self.learner not in ("fqi", "DQN", "PPO"):
+            raise ValueError(f"learner must be 'fqi', 'DQN' or 'PPO', got {self.learner!r}")
+        if self.learner == "fqi" and self.regressor not in REGRESSORS:
+            raise ValueError(f"regressor must be one of {tuple(REGRESSORS)}, got "
+                             f"{self.regressor!r}")
+        if not isinstance(self.steps, int) or self.steps < 1:
+            raise ValueError(f"steps must be a whole number >= 1, got {self.steps!r}")
+
+
+class Control(UnitKind):
+    """The mean return on held-out episodes against environment steps, the steps to the
+    task's threshold, and the seconds of training."""
+
+    name = "control"
+    Settings = ControlSettings
+    budget_fields = ("control_scale",)
+
+    def run(self, unit, checkpoint=None):
+        from ...training import EvalCallback, timed_learn, train_sb3  # imports torch
+
+        settings, scale = unit.settings, unit.budget.control_scale
+        steps = max(1, round(settings.steps * scale))
+        curve = EvalCallback(gym.make_vec(settings.env_id, settings.eval_episodes,
+                                          vectorization_mode="sync"),
+                             max(1, round(settings.eval_every * scale)),
+                             n_episodes=settings.eval_episodes)
+        if settings.learner == "fqi":
+            agent = FQI(REGRESSORS[settings.regressor](), settings.env_id, eval_episodes=0,
+                        seed=unit.seed, **settings.fqi)
+            seconds, cpu_seconds = timed_learn(agent, curve, total_timesteps=steps)
+            done = agent.num_timesteps
+        else:
+            model, seconds, cpu_seconds = train_sb3(
+                settings.learner, lambda: gym.make(settings.env_id), steps,
+                settings.hyperparams, seed=unit.seed, callback=curve)
+            done = model.num_timesteps
+        threshold = settings.threshold
+        solved = next((s for s, mean in curve.evaluations
+                       if threshold is not None and mean >= threshold), None)
+        return {"reward": curve.evaluations[-1][1], "curve": curve.evaluations,
+                "steps_to_threshold": solved, "total_timesteps": int(done),
+                "train_seconds": seconds, "train_cpu_seconds": cpu_seconds,
+                "eval_seconds": curve.eval_seconds}
+
+    def cost(self, unit):
+        return _SECONDS_PER_STEP * unit.settings.steps * unit.budget.control_scale
+
+    def record_shape(self, budget):
+        return {"reward": float, "curve": ListOf(ListOf(float, 2))}
+
+    def curve(self, stats, records):
+        curves = [np.array(r["result"]["curve"], dtype=float) for r in records]
+        points = min(len(c) for c in curves)  # the same evaluations, but for the last's step
+        curves = np.array([c[:points] for c in curves])
+        rewards = curves[:, :, 1]
+        return curves[:, :, 0].mean(axis=0), rewards.mean(axis=0), rewards.std(axis=0)
+
+    def plot(self, experiment, stats, runs, budget):
+        thresholds = {experiment.params(label).get("threshold") for label in stats}
+        curves = {label: self.curve(s, runs[label]) for label, s in stats.items()}
+        return plots.versus_steps(experiment, stats, curves, budget,
+                                  ylabel="mean return, held-out episodes",
+                                  threshold=thresholds.pop() if len(thresholds) == 1 else None)
+
+    def table(self, experiment, stats, runs):
+        lines = ["| setting | runs | final mean return +- sd over runs | runs solved | median "
+                 "steps to the threshold | training minutes per run (CPU) |",
+                 "| --- | --- | --- | --- | --- | --- |"]
+        for label, s in stats.items():
+            results = [r["result"] for r in runs[label]]
+            solved = [r["steps_to_threshold"] for r in results
+                      if r.get("steps_to_threshold") is not None]
+            minutes = np.mean([r["train_seconds"] for r in results]) / 60
+            cpu = np.mean([r["train_cpu_seconds"] for r in results]) / 60
+            lines.append(f"| {label} | {s.n_runs} | {s.score:,.1f} +- {s.score_sd:,.1f} | "
+                         f"{len(solved)}/{s.n_runs} | "
+                         f"{fmt(float(np.median(solved))) if solved else '-'} | "
+                         f"{minutes:.1f} ({cpu:.1f}) |")
+        return lines
