@@ -10,7 +10,7 @@
 
 Prints two tables and writes ``bench_attributes.json`` under ``--out``.
 
-    python benchmarks/bench_attributes.py [--out results] [--quick]
+    python -m benchmarks.bench_attributes [--out results] [--quick]
 """
 import argparse
 import json

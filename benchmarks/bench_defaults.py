@@ -13,7 +13,7 @@ Candidate settings of ``BoxExtraTreesRegressor`` (30 trees) on four kinds of dat
 
 Prints a table and writes ``bench_defaults.json`` under ``--out``.
 
-    python benchmarks/bench_defaults.py [--out results] [--n-jobs 2]
+    python -m benchmarks.bench_defaults [--out results] [--n-jobs 2]
 """
 import argparse
 import json

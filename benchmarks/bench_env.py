@@ -7,7 +7,7 @@ wrappers); the ratio uses the raw class, the faster of the two.
 
 Prints a table and writes ``bench_env.json`` under ``--out``.
 
-    python benchmarks/bench_env.py [--out results] [--steps 20000] [--worlds 400]
+    python -m benchmarks.bench_env [--out results] [--steps 20000] [--worlds 400]
 """
 import argparse
 import json

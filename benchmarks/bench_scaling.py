@@ -30,11 +30,11 @@ time of one FQI run of the treasure game at the thesis budget is estimated per v
 Prints a table and the log-log slopes, writes ``bench_scaling.json`` and ``bench_scaling.png``
 under ``--out``. ``--one`` grows a single tree and prints its time, for a profiler.
 
-    python benchmarks/bench_scaling.py [--objects 16 64 256 360] [--samples 5000 20000 80000]
+    python -m benchmarks.bench_scaling [--objects 16 64 256 360] [--samples 5000 20000 80000]
         [--views local global] [--game-samples 5000 20000] [--test-types fixed random]
         [--trees 2] [--out results] [--seed 0]
-    python benchmarks/bench_scaling.py --one global:random:5000
-    python benchmarks/bench_scaling.py --one synthetic:fixed:20000:360
+    python -m benchmarks.bench_scaling --one global:random:5000
+    python -m benchmarks.bench_scaling --one synthetic:fixed:20000:360
 """
 import argparse
 import json

@@ -29,7 +29,7 @@ A model that has learnt the rule keeps its accuracy at every size. Models:
 Writes ``bench_sets.json`` (accuracy by test size, fit and predict times) and
 ``bench_sets.png`` under ``--out``.
 
-    python benchmarks/bench_sets.py [--quick] [--out results] [--n-jobs 2] [--seed 0]
+    python -m benchmarks.bench_sets [--quick] [--out results] [--n-jobs 2] [--seed 0]
 """
 import argparse
 import json

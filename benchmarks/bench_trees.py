@@ -12,7 +12,7 @@ Workloads (thesis parameters K=500, n_min=30, M=30):
 
 Prints a table, writes ``bench_trees.json`` and ``bench_trees.png`` under ``--out``.
 
-    python benchmarks/bench_trees.py [--quick] [--out results] [--n-jobs 2]
+    python -m benchmarks.bench_trees [--quick] [--out results] [--n-jobs 2]
 """
 import argparse
 import json

@@ -9,7 +9,7 @@ heuristic (`envs.GreedyPolicy`) is deterministic. Thesis anchors: random about -
 
 Prints a table and writes ``calibrate_env.json`` under ``--out``.
 
-    python benchmarks/calibrate_env.py [--out results] [--policy-seeds 5]
+    python -m benchmarks.calibrate_env [--out results] [--policy-seeds 5]
 """
 import argparse
 import json

@@ -7,7 +7,7 @@ discs, walls grey squares, grass green triangles, enemies red diamonds, minimap 
 rings, the treasure's cell a blue diamond, the arrow a purple cross; the agent is the black
 disc, its view the dark blue square.
 
-    python benchmarks/render_env.py [--out docs/img]
+    python -m benchmarks.render_env [--out docs/img]
 """
 import argparse
 from pathlib import Path
