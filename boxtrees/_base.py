@@ -1,10 +1,7 @@
 """What the box-test tree estimators share: parameters, growing trees, walking them, and the
 encoding of regression and classification targets."""
 import inspect
-import os
-import threading
 import warnings
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from math import ceil
 from numbers import Integral, Real
@@ -24,6 +21,7 @@ from ._objects import (_FLOAT32_MAX, ObjectInputMixin, check_view_bounds, column
                        fitted_region, row_error)
 from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
+from ._threads import thread_pool
 from ._tree import BoxTree
 
 # prediction splits a batch into chunks of at least this many samples, one per thread
@@ -39,37 +37,6 @@ _Y_MAX = 2.0**511
 # the sampling region drawn from the training objects reaches this share of their extent
 # beyond them, on every side
 _REGION_MARGIN = 0.05
-
-
-_POOLS = {}  # threads -> the prediction threads of this process
-_POOLS_LOCK = threading.Lock()
-
-
-def _forget_pools_after_fork():
-    """In a forked child: the parent's threads are gone, and the lock may have been held."""
-    global _POOLS_LOCK
-    _POOLS.clear()
-    _POOLS_LOCK = threading.Lock()
-
-
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_forget_pools_after_fork)
-
-
-def _thread_pool(n_threads):
-    """The process's pool of `n_threads` prediction threads, started on first use.
-
-    Predictions are called once per environment step on batches of a few hundred samples,
-    where starting threads (as a joblib ``Parallel`` call does) costs about as much as the
-    work; the kernels release the GIL, so long-lived threads share a batch at no such cost.
-    So prediction takes its number of threads from ``n_jobs`` (and joblib's
-    ``parallel_config(n_jobs=...)``), not a joblib backend. A forked child starts its own.
-    """
-    with _POOLS_LOCK:
-        if n_threads not in _POOLS:
-            _POOLS[n_threads] = ThreadPoolExecutor(n_threads,
-                                                   thread_name_prefix="boxtrees-predict")
-        return _POOLS[n_threads]
 
 
 class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
@@ -175,7 +142,7 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             results = [kernel(packed, sets.data, sets.offsets, out)]
         else:
             edges = np.linspace(0, n, n_chunks + 1).astype(np.intp)
-            results = list(_thread_pool(n_threads).map(
+            results = list(thread_pool(n_threads).map(
                 lambda a, b: kernel(packed, sets.data, sets.offsets[a : b + 1], out[a:b]),
                 edges[:-1], edges[1:],
             ))

@@ -1,13 +1,9 @@
 """`FQI`: fitted Q-iteration with one scikit-learn regressor per action, on any gymnasium env."""
 import inspect
-import os
 import time
-import warnings
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from gymnasium.vector import VectorEnv
-from joblib import effective_n_jobs
 from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 from tqdm.auto import tqdm
@@ -21,6 +17,7 @@ from ._envs import _check_env, _close_built, _copy_vector, _make_vector, _n_acti
 from ._evaluate import _eval_seeds, evaluate
 from ._logger import CSVLogger, _KeyValueLogger
 from ._observations import _ObjectRows, _observation_format
+from ._q_function import _checked_prediction, _QFunction
 from ._saving import _read_save, _write_save
 
 __all__ = ["FQI"]
@@ -28,10 +25,10 @@ __all__ = ["FQI"]
 _DEFAULT_ENVS = 16
 # What `save` leaves out (SB3 saves its __dict__ minus such a list): the envs, which hold
 # simulators, the transitions, the threads and the logs.
-_UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_pool", "_data", "_csv_log",
+_UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_data", "_csv_log",
                       "_logger"})
 # What a save holds beyond the constructor parameters.
-_LEARNED = ("q_functions_", "history", "num_timesteps", "iteration", "observation_space",
+_LEARNED = ("_q", "history", "num_timesteps", "iteration", "observation_space",
             "action_space")
 
 
@@ -189,8 +186,7 @@ class FQI:
         self._fit_rng = np.random.default_rng(fit_seq)
         self.observation_space = self.action_space = None
         self.exploration_rate = self.exploration_initial_eps
-        self.q_functions_ = None
-        self._q_iteration = None  # the iteration that fitted q_functions_
+        self._q = None  # the last iteration's _QFunction
         self.history = []
         self.num_timesteps = 0
         self.iteration = 0
@@ -241,7 +237,6 @@ class FQI:
         self.verbose = _check_verbose(params["verbose"])
         self.log_path = params["log_path"]
         self._csv_log = None if self.log_path is None else CSVLogger(self.log_path)
-        self._pool = None
 
     # ------------------------------------------------------------------ envs
     def set_env(self, env, eval_env=None):
@@ -521,7 +516,7 @@ class FQI:
             try:
                 batch, n_steps = self._collector.collect(
                     n_samples, self._behaviour,
-                    None if self.q_functions_ is None else self._q_values)
+                    None if self._q is None else self._q_values)
             except Exception as exc:
                 exc.add_note(f"(while FQI collected the transitions of iteration "
                              f"{self.iteration} on {self._env})")
@@ -537,7 +532,7 @@ class FQI:
         collected = time.perf_counter()
 
         targets = data.rewards.copy()
-        if self.q_functions_ is not None:
+        if self._q is not None:
             future = data.next_values  # known when the data was just collected with Q_{n-1}
             if future is None:
                 future = self._q_values(data.next_states).max(axis=1)
@@ -545,8 +540,8 @@ class FQI:
         data.next_values = None  # stale once Q_n is fitted
         targeted = time.perf_counter()
 
-        self.q_functions_ = [self._fit_action(a, data, targets) for a in range(self.n_actions)]
-        self._q_iteration = self.iteration
+        self._q = _QFunction.fit(self.regressor, data, targets, self.n_actions, self._fit_rng,
+                                 self._q, self.iteration)
         fitted = time.perf_counter()
 
         result = (evaluate(self, self._eval_env, seeds=self._eval_seeds)
@@ -594,23 +589,6 @@ class FQI:
         return np.where(explore, self._action_rng.integers(self.n_actions, size=n),
                         q.argmax(axis=1))
 
-    def _fit_action(self, action, data, targets):
-        """A clone of the regressor fitted on the transitions with `action`."""
-        mask = data.actions == action
-        if not mask.any():
-            if self.q_functions_ is None:
-                raise ValueError(f"no transition with action {action} in the data; collect "
-                                 f"more samples per iteration")
-            warnings.warn(f"no transition with action {action} in the data; keeping its "
-                          f"previous Q-function", RuntimeWarning, stacklevel=3)
-            return self.q_functions_[action]
-        model = clone(self.regressor)
-        seed = int(self._fit_rng.integers(2**31 - 1))
-        params = model.get_params()
-        model.set_params(**{k: seed for k in params
-                            if k == "random_state" or k.endswith("__random_state")})
-        return model.fit(data.states[mask], targets[mask])
-
     # ------------------------------------------------------------------ acting
     def q_values(self, observation):
         """Q-values of every action.
@@ -629,23 +607,14 @@ class FQI:
         return q[0] if single else q
 
     def _q_values(self, batch):
-        if self.q_functions_ is None:
+        if self._q is None:
             raise NotFittedError("this FQI agent has no Q-function yet; call learn() first")
-        n_threads = min(effective_n_jobs(self.n_jobs), self.n_actions)
-        if n_threads == 1:
-            predictions = [model.predict(batch) for model in self.q_functions_]
-        else:
-            if self._pool is None or self._pool[0] != os.getpid():
-                # a forked child inherits the pool but not its threads: a pool of its own
-                self._pool = (os.getpid(), ThreadPoolExecutor(n_threads))
-            predictions = self._pool[1].map(lambda model: model.predict(batch),
-                                            self.q_functions_)
-        q = np.empty((len(batch), self.n_actions))
-        for action, prediction in enumerate(predictions):
-            q[:, action] = _checked_prediction(
-                prediction, len(batch), lambda: f"iteration {self._q_iteration}'s Q-function "
-                f"of action {action} ({self.q_functions_[action]!r})")
-        return q
+        return self._q.values(batch, self.n_jobs)
+
+    @property
+    def q_functions_(self):
+        """The fitted ``Q_n``, one regressor per action (None before the first iteration)."""
+        return None if self._q is None else self._q.models
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         """Actions for one observation or a batch (the stable-baselines3 signature).
@@ -737,11 +706,10 @@ class FQI:
     def __getstate__(self):
         """The agent's attributes for pickle: with its envs (an env that does not pickle
         makes the agent unpicklable) and random streams, so an unpickled agent learns on
-        exactly as this one would; less the threads, and less the transitions when the next
+        exactly as this one would; less the transitions when the next
         iteration replaces them, and less the `logger` (a copy starts with the default one).
         A ``log_path`` travels: a copy appends to its CSV."""
         state = self.__dict__.copy()
-        state["_pool"] = None  # threads do not pickle; a new pool starts on demand
         state["_logger"] = None  # SB3's loggers hold open files
         if self._collects() and not self.keep_data:
             state["_data"] = None
@@ -772,22 +740,6 @@ def _tried(vector, observations):
     observations.batch(obs)
     _checked_step(rewards, terminated, truncated, vector.num_envs)
     return first
-
-
-def _checked_prediction(prediction, n, describe):
-    """`prediction` for `n` observations, as floats of shape ``(n,)``, after checking there
-    are `n` of them and all are finite; ``describe()`` names the model in the error."""
-    prediction = np.asarray(prediction, dtype=np.float64)
-    bad = ~np.isfinite(prediction)
-    if prediction.size == n and not bad.any():
-        return prediction.reshape(n)
-    model = describe()
-    if prediction.size != n:
-        raise ValueError(f"{model} predicted an array of size {prediction.size} for "
-                         f"{n} observations; a regressor must predict one value per "
-                         f"observation")
-    raise ValueError(f"{model} predicted non-finite Q-values (NaN or inf) for {bad.sum()} "
-                     f"of {n} observations; a regressor must predict finite values")
 
 
 def _nodes_per_tree(models):

@@ -415,7 +415,7 @@ def _truncated_save(agent, path):
     (lambda agent, path: joblib.dump({"format": 1}, path),
      "FQI save of format version 1; this version of fqi reads version 3"),
     (lambda agent, path: joblib.dump({"format": 3, "state": {}}, path),
-     "not an agent saved by FQI.save: it lacks action_space, env, eval_env"),
+     "not an agent saved by FQI.save: it lacks _q, action_space, env, eval_env"),
     (lambda agent, path: joblib.dump({"format": 3, "state": [1]}, path),
      "not an agent saved by FQI.save: it lacks state"),
 ])
