@@ -1,6 +1,7 @@
 """`FQI`: fitted Q-iteration with one scikit-learn regressor per action, on any gymnasium env."""
 import inspect
 import time
+from contextlib import contextmanager
 
 import numpy as np
 from gymnasium.vector import VectorEnv
@@ -11,9 +12,10 @@ from tqdm.auto import tqdm
 from ._callbacks import _as_callback
 from ._checks import (_check_bool, _check_int, _check_n_jobs, _check_real, _check_seed,
                       _check_verbose)
-from ._collect import _checked_step, _Collector, _Transitions
+from ._collect import _Collector, _Transitions
 from ._datasets import _dataset_transitions
-from ._envs import _check_env, _close_built, _copy_vector, _make_vector, _n_actions
+from ._envs import (_check_env, _close_built, _evaluation_vector, _make_vector, _n_actions,
+                    _tried)
 from ._evaluate import _eval_seeds, evaluate
 from ._logger import CSVLogger, _KeyValueLogger
 from ._observations import _ObjectRows, _observation_format
@@ -274,8 +276,9 @@ class FQI:
                 raise ValueError(f"env has the spaces {observation_space} and {action_space}; "
                                  f"the agent was made for {self.observation_space} and "
                                  f"{self.action_space}")
-            eval_vector = self._evaluation_env(env, eval_env, vector,
-                                               (observation_space, action_space))
+            eval_vector = _evaluation_vector(env, eval_env, vector,
+                                             (observation_space, action_space),
+                                             len(self._eval_seeds))
             first = _tried(vector, observations)
             self._check_regressor(observations, first)
         except BaseException:
@@ -288,28 +291,6 @@ class FQI:
         self.n_actions, self._observations = n_actions, observations
         self._collector = None
         self._data = None
-
-    def _evaluation_env(self, env, eval_env, vector, spaces):
-        """The vector env of the evaluation after each iteration (None without one)."""
-        n = len(self._eval_seeds)
-        if n == 0:
-            return None
-        if eval_env is not None:
-            evaluation = _make_vector(eval_env, n)
-            found = (evaluation.single_observation_space, evaluation.single_action_space)
-            if found != spaces:
-                _close_built(evaluation, eval_env)
-                raise ValueError(f"eval_env has the spaces {found[0]} and {found[1]}; env "
-                                 f"has {spaces[0]} and {spaces[1]}")
-            return evaluation
-        if isinstance(env, VectorEnv):
-            evaluation = _copy_vector(vector, n)
-            if evaluation is None:
-                raise ValueError("a vector env without a spec cannot be rebuilt for the "
-                                 "evaluation after each iteration: give eval_env, or "
-                                 "eval_episodes=0 (and evaluate with fqi.evaluate)")
-            return evaluation
-        return _make_vector(env, n)
 
     def _check_regressor(self, observations, batch):
         """Fit a clone of the regressor on `batch` (zero targets) and check its predictions,
@@ -507,30 +488,54 @@ class FQI:
         ) * progress / self.exploration_fraction
 
     def _iterate(self, n_samples):
-        """One iteration: collect `n_samples` (when due; none offline), targets, fit,
-        evaluate; returns its record."""
-        start = time.perf_counter()
-        new = 0
-        collect_reward = np.nan
-        if n_samples and self._collects():
-            try:
-                batch, n_steps = self._collector.collect(
-                    n_samples, self._behaviour,
-                    None if self._q is None else self._q_values)
-            except Exception as exc:
-                exc.add_note(f"(while FQI collected the transitions of iteration "
-                             f"{self.iteration} on {self._env})")
-                raise
-            self.num_timesteps += n_steps
-            new, collect_reward = len(batch), float(batch.rewards.mean())
-            if self.keep_data and self._data is not None:
-                batch = _Transitions.concatenate([self._data, batch],
-                                                 self._observations.concatenate)
-                batch = batch[-self.max_samples:]
-            self._data = batch
-        data = self._data
-        collected = time.perf_counter()
+        """One iteration, in phases: collect `n_samples` (when due; none offline), targets,
+        fit, evaluate; then its record, logged. Returns the record."""
+        times = {}
+        with _timed(times, "t_collect"):
+            new, collect_reward = self._collect(n_samples)
+        with _timed(times, "t_targets"):
+            targets = self._targets(self._data)
+        with _timed(times, "t_fit"):
+            self._q = _QFunction.fit(self.regressor, self._data, targets, self.n_actions,
+                                     self._fit_rng, self._q, self.iteration)
+        with _timed(times, "t_evaluate"):
+            result = (evaluate(self, self._eval_env, seeds=self._eval_seeds)
+                      if self._eval_seeds else None)
+        record = {
+            "iteration": self.iteration, "reward": np.nan if result is None else result.total,
+            "mean_return": np.nan if result is None else result.mean,
+            "n_samples": len(self._data), "new_samples": new,
+            "num_timesteps": self.num_timesteps, "collect_reward_per_step": collect_reward,
+            "nodes_per_tree": _nodes_per_tree(self.q_functions_), **times,
+            "t_total": sum(times.values()),
+        }
+        self._log(record)
+        self.iteration += 1
+        return record
 
+    def _collect(self, n_samples):
+        """Collect `n_samples` transitions into the data set if this iteration collects;
+        returns how many were added and their mean reward (0 and NaN if none)."""
+        if not (n_samples and self._collects()):
+            return 0, np.nan
+        try:
+            batch, n_steps = self._collector.collect(
+                n_samples, self._behaviour, None if self._q is None else self._q_values)
+        except Exception as exc:
+            exc.add_note(f"(while FQI collected the transitions of iteration "
+                         f"{self.iteration} on {self._env})")
+            raise
+        self.num_timesteps += n_steps
+        new = (len(batch), float(batch.rewards.mean()))
+        if self.keep_data and self._data is not None:
+            batch = _Transitions.concatenate([self._data, batch], self._observations.concatenate)
+            batch = batch[-self.max_samples:]
+        self._data = batch
+        return new
+
+    def _targets(self, data):
+        """``r`` before any fit, then ``r + gamma * max_a Q_{n-1}(s', a)`` (no bootstrap
+        after a termination)."""
         targets = data.rewards.copy()
         if self._q is not None:
             future = data.next_values  # known when the data was just collected with Q_{n-1}
@@ -538,27 +543,12 @@ class FQI:
                 future = self._q_values(data.next_states).max(axis=1)
             targets += self.gamma * np.where(data.terminated, 0.0, future)
         data.next_values = None  # stale once Q_n is fitted
-        targeted = time.perf_counter()
+        return targets
 
-        self._q = _QFunction.fit(self.regressor, data, targets, self.n_actions, self._fit_rng,
-                                 self._q, self.iteration)
-        fitted = time.perf_counter()
-
-        result = (evaluate(self, self._eval_env, seeds=self._eval_seeds)
-                  if self._eval_seeds else None)
-        done = time.perf_counter()
-
-        record = {
-            "iteration": self.iteration, "reward": np.nan if result is None else result.total,
-            "mean_return": np.nan if result is None else result.mean,
-            "n_samples": len(data), "new_samples": new, "num_timesteps": self.num_timesteps,
-            "collect_reward_per_step": collect_reward,
-            "nodes_per_tree": _nodes_per_tree(self.q_functions_),
-            "t_collect": collected - start, "t_targets": targeted - collected,
-            "t_fit": fitted - targeted, "t_evaluate": done - fitted, "t_total": done - start,
-        }
+    def _log(self, record):
+        """Keep the iteration's `record` in `history` and write it to the CSV log, the
+        key-value logger and (verbose) the console."""
         self.history.append(record)
-        self.iteration += 1
         if self._csv_log is not None:
             self._csv_log.write(record)
         for key, value in record.items():
@@ -566,10 +556,9 @@ class FQI:
         self.logger.dump(step=self.num_timesteps)
         if self.verbose:
             print(f"iteration {record['iteration']:3d}  reward {record['reward']:>12,.0f}  "
-                  f"samples {len(data):>7,d}  collect {record['t_collect']:5.2f}s  "
+                  f"samples {record['n_samples']:>7,d}  collect {record['t_collect']:5.2f}s  "
                   f"targets {record['t_targets']:5.2f}s  fit {record['t_fit']:5.2f}s  "
                   f"evaluate {record['t_evaluate']:5.2f}s")
-        return record
 
     def _collects(self):
         """Whether the next iteration collects transitions."""
@@ -722,24 +711,12 @@ class FQI:
                 f"iteration={self.iteration})")
 
 
-def _tried(vector, observations):
-    """Reset `vector` and take one step (action 0 everywhere), checking what it returns;
-    the observations of the reset, as the regressor takes them."""
-    calls = {"reset": lambda: vector.reset(),
-             "step": lambda: vector.step(np.zeros(vector.num_envs, dtype=np.intp))}
-    results = {}
-    for name, call in calls.items():
-        try:
-            results[name] = call()
-        except Exception as exc:
-            raise RuntimeError(f"{vector}.{name} raised {type(exc).__name__}: {exc} (FQI "
-                               f"tries the env once when it is set: a reset, then a step "
-                               f"with action 0 in every env)") from exc
-    first = observations.batch(results["reset"][0])
-    obs, rewards, terminated, truncated, _ = results["step"]
-    observations.batch(obs)
-    _checked_step(rewards, terminated, truncated, vector.num_envs)
-    return first
+@contextmanager
+def _timed(times, name):
+    """Record the seconds the block takes as ``times[name]``."""
+    start = time.perf_counter()
+    yield
+    times[name] = time.perf_counter() - start
 
 
 def _nodes_per_tree(models):

@@ -4,7 +4,7 @@ from dataclasses import dataclass
 import numpy as np
 from gymnasium.vector import AutoresetMode
 
-from ._envs import _TRAINING_SEED_END, _autoreset_mode, _seeded_reset
+from ._envs import _TRAINING_SEED_END, _autoreset_mode, _checked_step, _seeded_reset
 
 __all__ = []
 
@@ -143,23 +143,3 @@ class _Collector:
             obs, _ = self.env.reset(options={"reset_mask": ended})
             self._obs = self.observations.batch(obs)
         return next_obs, rewards, terminated, truncated
-
-
-def _checked_step(rewards, terminated, truncated, n_envs):
-    """The step's rewards (float64) and flags (bool), checked: one finite reward and one
-    flag of each kind per env."""
-    rewards = np.asarray(rewards)
-    if rewards.shape != (n_envs,) or rewards.dtype.kind not in "biuf":
-        raise ValueError(f"the env returned rewards of shape {rewards.shape} and dtype "
-                         f"{rewards.dtype}; expected one number per env, shape ({n_envs},)")
-    if not np.isfinite(rewards).all():
-        raise ValueError(f"the env returned non-finite rewards (NaN or inf): "
-                         f"{rewards[~np.isfinite(rewards)][:3].tolist()}")
-    flags = []
-    for name, flag in (("terminated", terminated), ("truncated", truncated)):
-        flag = np.asarray(flag)
-        if flag.shape != (n_envs,) or flag.dtype.kind not in "biu":
-            raise ValueError(f"the env returned {name} of shape {flag.shape} and dtype "
-                             f"{flag.dtype}; expected one bool per env, shape ({n_envs},)")
-        flags.append(flag.astype(bool))
-    return rewards.astype(np.float64), *flags

@@ -1,4 +1,6 @@
-"""The vector envs that FQI and `evaluate` play on, built from what the user gives.
+"""The vector envs that FQI and `evaluate` play on, built from what the user gives, and
+tried once (a reset and a step, with the step's outputs checked) before the agent relies on
+them.
 
 An env argument is a registered id, a `gymnasium.Env` (wrappers allowed), a
 `gymnasium.vector.VectorEnv` (used as it is) or a factory returning a `gymnasium.Env`.
@@ -9,6 +11,7 @@ import copy
 from functools import partial
 
 import gymnasium as gym
+import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, SyncVectorEnv, VectorEnv
 
@@ -139,3 +142,67 @@ def _seeded_reset(vector, seeds):
     except (gym.error.Error, TypeError, ValueError):
         obs, _ = vector.reset(seed=int(seeds[0]))
     return obs
+
+
+def _evaluation_vector(env, eval_env, vector, spaces, n):
+    """The vector env of `n` evaluation episodes after each iteration (None for none): built
+    from `eval_env`, which must have the `spaces`, else from `env` (a vector env rebuilt from
+    its spec)."""
+    if n == 0:
+        return None
+    if eval_env is not None:
+        evaluation = _make_vector(eval_env, n)
+        found = (evaluation.single_observation_space, evaluation.single_action_space)
+        if found != spaces:
+            _close_built(evaluation, eval_env)
+            raise ValueError(f"eval_env has the spaces {found[0]} and {found[1]}; env "
+                             f"has {spaces[0]} and {spaces[1]}")
+        return evaluation
+    if isinstance(env, VectorEnv):
+        evaluation = _copy_vector(vector, n)
+        if evaluation is None:
+            raise ValueError("a vector env without a spec cannot be rebuilt for the "
+                             "evaluation after each iteration: give eval_env, or "
+                             "eval_episodes=0 (and evaluate with fqi.evaluate)")
+        return evaluation
+    return _make_vector(env, n)
+
+
+def _tried(vector, observations):
+    """Reset `vector` and take one step (action 0 everywhere), checking what it returns;
+    the observations of the reset, as the regressor takes them."""
+    calls = {"reset": lambda: vector.reset(),
+             "step": lambda: vector.step(np.zeros(vector.num_envs, dtype=np.intp))}
+    results = {}
+    for name, call in calls.items():
+        try:
+            results[name] = call()
+        except Exception as exc:
+            raise RuntimeError(f"{vector}.{name} raised {type(exc).__name__}: {exc} (FQI "
+                               f"tries the env once when it is set: a reset, then a step "
+                               f"with action 0 in every env)") from exc
+    first = observations.batch(results["reset"][0])
+    obs, rewards, terminated, truncated, _ = results["step"]
+    observations.batch(obs)
+    _checked_step(rewards, terminated, truncated, vector.num_envs)
+    return first
+
+
+def _checked_step(rewards, terminated, truncated, n_envs):
+    """The step's rewards (float64) and flags (bool), checked: one finite reward and one
+    flag of each kind per env."""
+    rewards = np.asarray(rewards)
+    if rewards.shape != (n_envs,) or rewards.dtype.kind not in "biuf":
+        raise ValueError(f"the env returned rewards of shape {rewards.shape} and dtype "
+                         f"{rewards.dtype}; expected one number per env, shape ({n_envs},)")
+    if not np.isfinite(rewards).all():
+        raise ValueError(f"the env returned non-finite rewards (NaN or inf): "
+                         f"{rewards[~np.isfinite(rewards)][:3].tolist()}")
+    flags = []
+    for name, flag in (("terminated", terminated), ("truncated", truncated)):
+        flag = np.asarray(flag)
+        if flag.shape != (n_envs,) or flag.dtype.kind not in "biu":
+            raise ValueError(f"the env returned {name} of shape {flag.shape} and dtype "
+                             f"{flag.dtype}; expected one bool per env, shape ({n_envs},)")
+        flags.append(flag.astype(bool))
+    return rewards.astype(np.float64), *flags
