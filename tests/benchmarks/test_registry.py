@@ -125,3 +125,12 @@ def test_an_ablations_game_constants_and_ridge_penalty_reach_its_units():
     assert ridge[0].n_bins == 15 and ridge[-1].alpha == 1000.0
     other = regressor(settings(REGISTRY["fqi_grid"], "N=15"), make_env(grid), TINY, 0)
     assert other[-1].alpha == 1.0
+
+
+def test_the_reference_worlds_are_seeds_fqi_never_trains_on():
+    """The two packages cannot import each other; the harness joins them on one boundary."""
+    import envs
+    from fqi._envs import _TRAINING_SEED_END
+
+    assert envs.REFERENCE_SEED_START == _TRAINING_SEED_END
+    assert min(envs.reference_worlds(3)) == _TRAINING_SEED_END
