@@ -46,10 +46,15 @@ ZOO_PPO = {
     "Acrobot-v1": {"normalize": True, "n_envs": 16, "n_steps": 256, "gae_lambda": 0.94,
                    "gamma": 0.99, "n_epochs": 4, "ent_coef": 0.0},
 }
+# gymnasium's LunarLander-v3 is rl-zoo3's LunarLander-v2 with its bugs fixed: the same settings
+ZOO_DQN["LunarLander-v3"] = ZOO_DQN["LunarLander-v2"]
+ZOO_PPO["LunarLander-v3"] = ZOO_PPO["LunarLander-v2"]
 # rl-zoo3's training budgets (environment steps)
 ZOO_STEPS = {
-    "DQN": {"CartPole-v1": 50_000, "Acrobot-v1": 100_000, "MountainCar-v0": 120_000},
-    "PPO": {"CartPole-v1": 100_000, "Acrobot-v1": 1_000_000, "MountainCar-v0": 1_000_000},
+    "DQN": {"CartPole-v1": 50_000, "Acrobot-v1": 100_000, "MountainCar-v0": 120_000,
+            "LunarLander-v3": 100_000},
+    "PPO": {"CartPole-v1": 100_000, "Acrobot-v1": 1_000_000, "MountainCar-v0": 1_000_000,
+            "LunarLander-v3": 1_000_000},
 }
 
 

@@ -533,7 +533,8 @@ EXPERIMENTS += (
 
 # FQI on gymnasium's tasks, with the library's defaults and nothing tuned per task, against
 # rl-zoo3's tuned DQN and PPO at their own budgets (on demand: ``--only control_cartpole``).
-_CONTROL = {"CartPole-v1": 475.0, "Acrobot-v1": -100.0, "MountainCar-v0": -110.0}
+_CONTROL = {"CartPole-v1": 475.0, "Acrobot-v1": -100.0, "MountainCar-v0": -110.0,
+            "LunarLander-v3": 200.0}
 
 
 def _control(env_id):

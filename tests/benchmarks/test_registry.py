@@ -19,7 +19,7 @@ def test_registry_covers_every_thesis_figure_once():
     assert {e.name for e in EXPERIMENTS if e.figure == "extra" and not e.explains} == {
         "keep_data", "dqn", "attention", "ceiling", "ceiling_sword", "baselines",
         "search_dqn_grid", "search_dqn_objects", "search_ppo_objects", "control_cartpole",
-        "control_acrobot", "control_mountaincar", "fqi_defaults"}
+        "control_acrobot", "control_mountaincar", "control_lunarlander", "fqi_defaults"}
     ablations = [e for e in EXPERIMENTS if e.explains]
     assert {name for e in ablations for name in e.explains} == {
         "rmse_K", "rmse_nmin", "rmse_TW", "rmse_grid", "fqi_grid", "representations",
@@ -29,7 +29,7 @@ def test_registry_covers_every_thesis_figure_once():
         assert all(REGISTRY[name].figure != "extra" for name in ablation.explains)
     assert {e.name for e in EXPERIMENTS if e.on_demand} == {
         "search_dqn_grid", "search_dqn_objects", "search_ppo_objects", "control_cartpole",
-        "control_acrobot", "control_mountaincar", "fqi_defaults"}
+        "control_acrobot", "control_mountaincar", "control_lunarlander", "fqi_defaults"}
     assert len(REGISTRY) == len(EXPERIMENTS)
 
 
