@@ -9,20 +9,22 @@ __all__ = ["PaddedObjects", "strip_padding"]
 
 
 class PaddedObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
-    """Pad the object set to a fixed ``(max_objects, 4)`` `Box` (e.g. for stable-baselines3).
+    """Pad the object set to a fixed ``(max_objects, d + 2)`` `Box` (e.g. for stable-baselines3).
 
-    Row ``j`` is ``[dx, dy, type, valid]``: the first ``n`` rows hold the observed objects
-    with ``valid = 1``, the remaining rows are zeros (``valid = 0``). `strip_padding` turns
-    padded observations back into object sets. When more than `max_objects` objects are in
-    view, the `max_objects` nearest to the agent are kept (in their original order). The
-    wrapper records `max_objects` in the env's spec, so ``gymnasium.make(env.spec)`` rebuilds
-    it.
+    Row ``j`` is ``[f_1, ..., f_d, type, valid]`` (``[dx, dy, type, valid]`` for the
+    thesis's game): the first ``n`` rows hold the observed objects with ``valid = 1``, the
+    remaining rows are zeros (``valid = 0``). `strip_padding` turns padded observations
+    back into object sets. When more than `max_objects` objects are observed, the
+    `max_objects` nearest to the agent are kept (in their original order), the distance
+    read off the first two attributes (the first alone when ``d = 1``), which are the
+    position relative to the agent in every env of this package. The wrapper records
+    `max_objects` in the env's spec, so ``gymnasium.make(env.spec)`` rebuilds it.
 
     Parameters
     ----------
     env : gymnasium.Env
-        An environment whose observation space is ``Sequence(Box(3,), stack=True)``, such as
-        `ObjectWorldEnv`.
+        An environment whose observation space is ``Sequence(Box(d + 1,), stack=True)``
+        with ``d >= 1``, such as `ObjectWorldEnv` or `AtariObjects`.
     max_objects : int
         Number of rows of the padded observation.
 
@@ -32,7 +34,7 @@ class PaddedObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         If `max_objects` is not an int (bools and floats such as ``8.0`` included).
     ValueError
         If `max_objects` is below 1, or the env's observation space is not
-        ``Sequence(Box(3,), stack=True)``.
+        ``Sequence(Box(d + 1,), stack=True)``.
 
     Examples
     --------
@@ -50,9 +52,9 @@ class PaddedObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         space = env.observation_space
         if not (isinstance(space, spaces.Sequence) and space.stack
                 and isinstance(space.feature_space, spaces.Box)
-                and space.feature_space.shape == (3,)):
-            raise ValueError("PaddedObjects needs an observation space Sequence(Box(3,), "
-                             f"stack=True), got {space}")
+                and len(space.feature_space.shape) == 1 and space.feature_space.shape[0] >= 2):
+            raise ValueError("PaddedObjects needs an observation space Sequence(Box(d + 1,), "
+                             f"stack=True) with d >= 1, got {space}")
         if not isinstance(max_objects, Integral) or isinstance(max_objects, bool):
             raise TypeError(f"max_objects must be a positive int, got {max_objects!r}")
         if max_objects < 1:
@@ -66,27 +68,28 @@ class PaddedObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
                                             dtype=np.float32)
 
     def observation(self, observation):
-        """Pad (or cut) one object set to the fixed ``(max_objects, 4)`` observation.
+        """Pad (or cut) one object set to the fixed ``(max_objects, d + 2)`` observation.
 
         Parameters
         ----------
-        observation : ndarray of float32 of shape (n, 3)
-            The wrapped env's observation, rows ``[dx, dy, type]``.
+        observation : ndarray of float32 of shape (n, d + 1)
+            The wrapped env's observation, rows ``[f_1, ..., f_d, type]``.
 
         Returns
         -------
-        padded : ndarray of float32 of shape (max_objects, 4)
-            Rows ``[dx, dy, type, 1]`` for the objects kept, then rows of zeros. If
+        padded : ndarray of float32 of shape (max_objects, d + 2)
+            Rows ``[f_1, ..., f_d, type, 1]`` for the objects kept, then rows of zeros. If
             ``n > max_objects``, the `max_objects` objects nearest to the agent are kept, in
             their original order (ties at the cut broken by ``numpy.argpartition``).
         """
-        padded = np.zeros((self.max_objects, 4), dtype=np.float32)
+        width = observation.shape[1]
+        padded = np.zeros((self.max_objects, width + 1), dtype=np.float32)
         if len(observation) > self.max_objects:
-            dist = np.hypot(observation[:, 0], observation[:, 1])
+            dist = np.linalg.norm(observation[:, :min(2, width - 1)], axis=1)
             keep = np.sort(np.argpartition(dist, self.max_objects - 1)[:self.max_objects])
             observation = observation[keep]
-        padded[:len(observation), :3] = observation
-        padded[:len(observation), 3] = 1.0
+        padded[:len(observation), :width] = observation
+        padded[:len(observation), width] = 1.0
         return padded
 
 
@@ -95,17 +98,18 @@ def strip_padding(padded):
 
     Parameters
     ----------
-    padded : array-like of shape (max_objects, 4) or (batch, max_objects, 4)
-        Rows ``[dx, dy, type, valid]``.
+    padded : array-like of shape (max_objects, d + 2) or (batch, max_objects, d + 2)
+        Rows ``[f_1, ..., f_d, type, valid]``.
 
     Returns
     -------
-    sets : list of ndarray of float32 of shape (n_i, 3)
+    sets : list of ndarray of float32 of shape (n_i, d + 1)
         The valid rows of each observation (a list of one for a single observation).
     """
     padded = np.asarray(padded, dtype=np.float32)
-    if padded.ndim not in (2, 3) or padded.shape[-1] != 4:
-        raise ValueError("padded observations must have shape (max_objects, 4) or "
-                         f"(batch, max_objects, 4) with a last 'valid' column; got {padded.shape}")
+    if padded.ndim not in (2, 3) or padded.shape[-1] < 3:
+        raise ValueError("padded observations must have shape (max_objects, d + 2) or "
+                         "(batch, max_objects, d + 2), d >= 1, with a last 'valid' column; "
+                         f"got {padded.shape}")
     batch = padded[None] if padded.ndim == 2 else padded
-    return [rows[rows[:, 3] > 0.5, :3] for rows in batch]
+    return [rows[rows[:, -1] > 0.5, :-1] for rows in batch]

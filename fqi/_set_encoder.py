@@ -13,9 +13,10 @@ __all__ = ["SetEncoder"]
 class SetEncoder(BaseFeaturesExtractor):
     """Deep Sets encoder of padded objects, with an optional masked self-attention layer.
 
-    Reads observations of shape ``(max_objects, 4)`` whose rows are ``[dx, dy, type, valid]``
-    (``envs.PaddedObjects``, or any wrapper with that layout): each valid object becomes
-    ``[dx / scale, dy / scale, one-hot type]``, goes through a shared MLP (and, with
+    Reads observations of shape ``(max_objects, d + 2)`` whose rows are ``[f_1, ..., f_d,
+    type, valid]``, ``d >= 1`` (``envs.PaddedObjects``, or any wrapper with that layout;
+    ``[dx, dy, type, valid]`` for the thesis's game): each valid object becomes
+    ``[f_1 / scale_1, ..., f_d / scale_d, one-hot type]``, goes through a shared MLP (and, with
     ``attention``, one residual multi-head self-attention layer over the valid objects),
     and the set is pooled by the mean and the maximum over its valid objects, then mapped
     by an MLP to ``features_dim`` features. Padding rows take no part anywhere, so the
@@ -25,9 +26,10 @@ class SetEncoder(BaseFeaturesExtractor):
     Parameters
     ----------
     observation_space : gymnasium.spaces.Box
-        Of shape ``(max_objects, 4)``. The largest type id is read from the upper bound of
-        the type column and the coordinate scale from the bounds of the ``dx``, ``dy``
-        columns, so the encoder needs no knowledge of the game.
+        Of shape ``(max_objects, d + 2)``. The largest type id is read from the upper bound
+        of the type column and each attribute's scale from the bounds of its column (the
+        largest absolute bound; 1 where that is infinite or 0), so the encoder needs no
+        knowledge of the game.
     embed_dim : int, default=64
         Width of the per-object MLP.
     features_dim : int, default=128
@@ -53,9 +55,10 @@ class SetEncoder(BaseFeaturesExtractor):
     def __init__(self, observation_space, embed_dim=64, features_dim=128, attention=False,
                  n_heads=4):
         if not (isinstance(observation_space, spaces.Box) and len(observation_space.shape) == 2
-                and observation_space.shape[1] == 4):
-            raise ValueError(f"SetEncoder needs a Box observation space of shape "
-                             f"(max_objects, 4), rows [dx, dy, type, valid]; got {observation_space}")
+                and observation_space.shape[1] >= 3):
+            raise ValueError(f"SetEncoder needs a Box observation space of shape (max_objects, "
+                             f"d + 2), rows [f_1, ..., f_d, type, valid] with d >= 1; got "
+                             f"{observation_space}")
         for name, value in (("embed_dim", embed_dim), ("features_dim", features_dim),
                             ("n_heads", n_heads)):
             if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < 1:
@@ -64,24 +67,28 @@ class SetEncoder(BaseFeaturesExtractor):
         if attention and embed_dim % n_heads:
             raise ValueError(f"n_heads ({n_heads}) must divide embed_dim ({embed_dim})")
         high, low = observation_space.high[0], observation_space.low[0]
-        if not (np.isfinite(high[2]) and high[2] >= 0):
+        d = observation_space.shape[1] - 2
+        if not (np.isfinite(high[d]) and high[d] >= 0):
             raise ValueError(f"SetEncoder reads the number of types from the upper bound of "
                              f"the type column, which must be finite and >= 0; got "
-                             f"{high[2]} in {observation_space}")
+                             f"{high[d]} in {observation_space}")
         super().__init__(observation_space, features_dim)
-        self.n_types = int(high[2]) + 1
-        scale = float(np.max(np.abs([low[:2], high[:2]])))
-        self.scale = scale if np.isfinite(scale) and scale > 0 else 1.0
-        self.objects = nn.Sequential(nn.Linear(2 + self.n_types, embed_dim), nn.ReLU(),
+        self.n_attributes, self.n_types = d, int(high[d]) + 1
+        bounds = np.max(np.abs([low[:d], high[:d]]), axis=0).astype(np.float64)
+        scale = np.where(np.isfinite(bounds) & (bounds > 0), bounds, 1.0)
+        self.register_buffer("scale", torch.as_tensor(scale, dtype=torch.float32),
+                             persistent=False)
+        self.objects = nn.Sequential(nn.Linear(d + self.n_types, embed_dim), nn.ReLU(),
                                      nn.Linear(embed_dim, embed_dim), nn.ReLU())
         self.attention = (nn.MultiheadAttention(embed_dim, n_heads, batch_first=True)
                           if attention else None)
         self.head = nn.Sequential(nn.Linear(2 * embed_dim, features_dim), nn.ReLU())
 
     def forward(self, observations):
-        valid = observations[..., 3] > 0.5                          # (batch, max_objects)
-        types = observations[..., 2].round().long().clamp(0, self.n_types - 1)
-        rows = torch.cat([observations[..., :2] / self.scale,
+        d = self.n_attributes
+        valid = observations[..., d + 1] > 0.5                      # (batch, max_objects)
+        types = observations[..., d].round().long().clamp(0, self.n_types - 1)
+        rows = torch.cat([observations[..., :d] / self.scale,
                           nn.functional.one_hot(types, self.n_types).float()], dim=-1)
         hidden = self.objects(rows)
         if self.attention is not None:

@@ -641,7 +641,7 @@ def test_bad_wrapper_input():
     with pytest.raises(ValueError, match="Sequence"):
         envs.PaddedObjects(gym.make("CartPole-v1"), 8)
     with pytest.raises(ValueError, match="valid"):
-        envs.strip_padding(np.zeros((8, 3)))
+        envs.strip_padding(np.zeros((8, 2)))
     with pytest.raises(ValueError, match="valid"):
         envs.strip_padding(np.zeros(4))
     with pytest.raises(ValueError, match="non-negative"):

@@ -68,8 +68,8 @@ def test_the_encoder_trains_with_dqn_and_ppo(algorithm):
 def test_bad_parameters_are_rejected(kwargs, match):
     with pytest.raises(ValueError, match=match):
         SetEncoder(padded_env().observation_space, **kwargs)
-    with pytest.raises(ValueError, match=r"shape \(max_objects, 4\)"):
-        SetEncoder(gym.spaces.Box(0, 1, (5, 3)))
+    with pytest.raises(ValueError, match=r"shape \(max_objects, d \+ 2\)"):
+        SetEncoder(gym.spaces.Box(0, 1, (5, 2)))
 
 
 def test_an_unbounded_type_column_or_a_non_bool_attention_is_rejected():
