@@ -28,6 +28,9 @@ $(VENV)/.installed: $(SOURCES)
 	    || { echo "torch: nothing from $(TORCH_INDEX); trying pip's usual indexes"; \
 	         $(PY) -m pip install -q -c constraints.txt torch; }
 	$(PY) -m pip install -q -c constraints.txt -e '.[dev]'
+	# ocatari declares numpy<2: the dev extra has what it runs on (the extra atari-deps), and
+	# it goes in alone, so NumPy stays at 2 (envs.AtariObjects runs every game on it)
+	$(PY) -m pip install -q -c constraints.txt --no-deps ocatari
 	touch $@
 
 clean:

@@ -13,6 +13,10 @@ Every rule constant is a keyword argument (see `WorldRules`), e.g.
 their episodes themselves after ``max_steps`` steps; the ids register the default,
 ``max_episode_steps=50``, so ``gymnasium.spec(id)`` reports it and the `TimeLimit` that
 ``gymnasium.make`` adds truncates on the same step (see `ObjectWorldEnv` for other lengths).
+
+Real games as object sets, with optional packages imported on first use:
+`AtariObjects` (any game of OCAtari, also registered as ``AtariObjects-v0``; the extra
+``atari``) and `HighwayObjects` (a wrapper of any highway-env env; the extra ``highway``).
 """
 from gymnasium.envs.registration import register
 
@@ -33,7 +37,10 @@ __all__ = [
     "LookaheadPlanner",
     "MONEY", "WALL", "GRASS", "ENEMY", "MONEY_MARKER", "TREASURE_MARKER", "ARROW",
     "TYPE_NAMES", "TYPE_COLOURS", "ACTION_NAMES", "VIEWS",
+    "AtariObjects", "atari_games", "HighwayObjects",
 ]
+# name -> module of the adapters of real games, whose packages are imported on first use
+_LAZY = {"AtariObjects": "atari", "atari_games": "atari", "HighwayObjects": "highway"}
 
 _SPEC = {"entry_point": "envs.object_world:ObjectWorldEnv",
          "vector_entry_point": "envs.batched:_make_vec",
@@ -41,3 +48,12 @@ _SPEC = {"entry_point": "envs.object_world:ObjectWorldEnv",
 register(id="ObjectWorld-v0", **_SPEC)
 register(id="ObjectWorldSword-v0", kwargs={"sword": True}, **_SPEC)
 register(id="ObjectWorldTreasure-v0", kwargs={"treasure": True}, **_SPEC)
+register(id="AtariObjects-v0", entry_point="envs.atari:AtariObjects")
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        from importlib import import_module
+
+        return getattr(import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
