@@ -557,6 +557,13 @@ def _control(env_id):
               f"settings and budgets; one core per run.")
 
 
+# The defaults of `fqi.FQI` that the settings ``"fqi": {}`` of the control experiments ran with:
+# the cache keys hold the settings, not the library's defaults, so a change of those defaults
+# must change this (a test compares them) and delete the runs they made.
+FQI_DEFAULTS_MEASURED = {
+    "gamma": 0.99, "samples_per_iteration": 2_500, "resample_every": 5, "keep_data": True,
+    "max_samples": 100_000, "exploration_fraction": 0.1, "exploration_initial_eps": 1.0,
+    "exploration_final_eps": 0.05}
 # The defaults of FQI, measured: variations of one setting at a time on CartPole-v1.
 _FQI_VARIANTS = {
     "defaults": {},

@@ -134,3 +134,16 @@ def test_the_reference_worlds_are_seeds_fqi_never_trains_on():
 
     assert envs.REFERENCE_SEED_START == _TRAINING_SEED_END
     assert min(envs.reference_worlds(3)) == _TRAINING_SEED_END
+
+
+def test_the_control_runs_measured_fqis_current_defaults():
+    """Their cache keys hold ``"fqi": {}``: a change of FQI's defaults would reuse runs of
+    the old ones. This fails first (then delete those runs and update the record)."""
+    import inspect
+
+    from benchmarks.reproduce.registry import FQI_DEFAULTS_MEASURED
+    from fqi import FQI
+
+    defaults = {name: parameter.default
+                for name, parameter in inspect.signature(FQI).parameters.items()}
+    assert {name: defaults[name] for name in FQI_DEFAULTS_MEASURED} == FQI_DEFAULTS_MEASURED
