@@ -1,5 +1,7 @@
 """What the box-test tree estimators share: parameters, growing trees, walking them, and the
 encoding of regression and classification targets."""
+from __future__ import annotations
+
 import inspect
 import warnings
 from dataclasses import dataclass
@@ -23,6 +25,7 @@ from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
 from ._threads import thread_pool
 from ._tree import BoxTree
+from ._typing import SetsOrMatrix
 
 # prediction splits a batch into chunks of at least this many samples, one per thread
 _PREDICT_CHUNK_MIN = 64
@@ -254,7 +257,7 @@ class _Bootstrap:
     classes of the draw."""
 
     n_draws: int
-    labels: np.ndarray = None
+    labels: np.ndarray | None = None
 
     def counts(self, seed, n):
         """How many times each of ``n`` samples is drawn for the tree of ``seed``: the
@@ -336,7 +339,7 @@ class RegressionTargets(RegressorMixin):
         self.n_outputs_ = 1 if y.ndim == 1 else y.shape[1]
         return y
 
-    def predict(self, X):
+    def predict(self, X: SetsOrMatrix) -> np.ndarray:
         """Predict the mean of the trees' leaf values.
 
         Parameters
@@ -393,7 +396,7 @@ class ClassificationTargets(ClassifierMixin):
         """Split class-frequency columns into one block per output."""
         return np.split(values, np.cumsum(np.atleast_1d(self.n_classes_))[:-1], axis=1)
 
-    def predict_proba(self, X):
+    def predict_proba(self, X: SetsOrMatrix) -> np.ndarray | list[np.ndarray]:
         """Class probabilities: the mean over the trees of the leaves' class frequencies.
 
         Parameters
@@ -408,13 +411,13 @@ class ClassificationTargets(ClassifierMixin):
         blocks = self._per_output(self._predict_mean(X, getattr(self, "n_jobs", None)))
         return blocks[0] if self.n_outputs_ == 1 else blocks
 
-    def predict_log_proba(self, X):
+    def predict_log_proba(self, X: SetsOrMatrix) -> np.ndarray | list[np.ndarray]:
         """Logarithm of `predict_proba` (``-inf`` for a zero probability)."""
         proba = self.predict_proba(X)
         with np.errstate(divide="ignore"):
             return np.log(proba) if self.n_outputs_ == 1 else [np.log(p) for p in proba]
 
-    def predict(self, X):
+    def predict(self, X: SetsOrMatrix) -> np.ndarray:
         """The most probable class of each sample (the first in ``classes_`` on a tie).
 
         Returns

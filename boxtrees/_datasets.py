@@ -1,12 +1,16 @@
 """Synthetic regression data over object sets."""
+from __future__ import annotations
+
 import math
 from numbers import Integral, Real
 
 import numpy as np
+from numpy.typing import ArrayLike
 from sklearn.utils import check_random_state
-from sklearn.utils._param_validation import Interval, validate_params
+from sklearn.utils._param_validation import Interval
 
 from ._objects import _FLOAT32_MAX, _MAX_TYPE, ObjectSets, _offsets_from_sizes
+from ._typing import RandomStateLike, validate_params
 
 __all__ = ["make_box_regression"]
 
@@ -19,7 +23,8 @@ def _is_finite(value):
         return False
 
 
-def _finite_vector(value, name, shape=None):
+def _finite_vector(value: ArrayLike, name: str, shape: tuple[int, ...] | None = None
+                   ) -> np.ndarray:
     """``value`` as a float64 array of finite numbers (1D, or of ``shape`` when given), or a
     ValueError naming the parameter ``name``."""
     what = f"The {name!r} parameter of make_box_regression must"
@@ -52,17 +57,17 @@ def _finite_vector(value, name, shape=None):
     prefer_skip_nested_validation=True,
 )
 def make_box_regression(
-    n_samples=1000,
+    n_samples: int = 1000,
     *,
-    mean_objects=16,
-    n_types=4,
-    extent=10.0,
-    centre=(0.0, 1.0),
-    half_width=1.5,
-    type_values=(100.0, -300.0),
-    noise=10.0,
-    random_state=None,
-):
+    mean_objects: float = 16,
+    n_types: int = 4,
+    extent: float = 10.0,
+    centre: ArrayLike = (0.0, 1.0),
+    half_width: float = 1.5,
+    type_values: ArrayLike = (100.0, -300.0),
+    noise: float = 10.0,
+    random_state: RandomStateLike = None,
+) -> tuple[ObjectSets, np.ndarray]:
     """Generate random object sets whose target counts objects of some types inside a box.
 
     Each sample holds a Poisson(``mean_objects``) number of objects, uniform in

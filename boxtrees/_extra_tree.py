@@ -1,14 +1,21 @@
 """One Extra-Tree whose node tests count objects in boxes: ``BoxExtraTreeRegressor`` and
 ``BoxExtraTreeClassifier``."""
+from __future__ import annotations
+
+from collections.abc import Sequence
 from numbers import Integral
+from typing import Self
 
 import numpy as np
-from sklearn.base import _fit_context
+from numpy.typing import ArrayLike
+from scipy.sparse import csr_matrix
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import check_is_fitted
 
 from ._base import BaseBoxTrees, ClassificationTargets, RegressionTargets
+from ._tree import BoxTree
+from ._typing import RandomStateLike, SetsOrMatrix, TestType, fit_context
 
 __all__ = ["BoxExtraTreeClassifier", "BoxExtraTreeRegressor"]
 
@@ -36,6 +43,8 @@ def _tree_seed(random_state):
 class _SingleTree(BaseBoxTrees):
     """Fitting and walking one tree (the regressor and the classifier share it)."""
 
+    tree_: BoxTree
+
     _parameter_constraints = {
         **BaseBoxTrees._parameter_constraints,
         "random_state": [Interval(Integral, 0, _SEED_MAX, closed="both"), "random_state"],
@@ -44,18 +53,18 @@ class _SingleTree(BaseBoxTrees):
     def __init__(
         self,
         *,
-        n_tests=500,
-        min_samples_split=30,
-        test_type="random",
-        test_width=0.1,
-        max_retries=10,
-        max_depth=None,
-        view_bounds=None,
-        column_groups=None,
-        relative_width=True,
-        refine_tests=True,
-        random_state=None,
-    ):
+        n_tests: int = 500,
+        min_samples_split: int | float = 30,
+        test_type: TestType = "random",
+        test_width: float = 0.1,
+        max_retries: int = 10,
+        max_depth: int | None = None,
+        view_bounds: ArrayLike | float | None = None,
+        column_groups: Sequence[int | Sequence[int]] | None = None,
+        relative_width: bool = True,
+        refine_tests: bool = True,
+        random_state: RandomStateLike = None,
+    ) -> None:
         self.n_tests = n_tests
         self.min_samples_split = min_samples_split
         self.test_type = test_type
@@ -68,8 +77,8 @@ class _SingleTree(BaseBoxTrees):
         self.refine_tests = refine_tests
         self.random_state = random_state
 
-    @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y, sample_weight=None):
+    @fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X: SetsOrMatrix, y: ArrayLike, sample_weight: ArrayLike | None = None) -> Self:
         """Grow the tree.
 
         Parameters
@@ -94,7 +103,7 @@ class _SingleTree(BaseBoxTrees):
     def _trees(self):
         return [self.tree_] if "tree_" in self.__dict__ else None
 
-    def apply(self, X):
+    def apply(self, X: SetsOrMatrix) -> np.ndarray:
         """Return the index of the leaf each sample reaches.
 
         Parameters
@@ -109,25 +118,25 @@ class _SingleTree(BaseBoxTrees):
         check_is_fitted(self)
         return self._apply(X)[:, 0]
 
-    def decision_path(self, X):
+    def decision_path(self, X: SetsOrMatrix) -> csr_matrix:
         """Return the nodes each sample passes through, from the root to its leaf, as a
         CSR indicator matrix of shape ``(n_samples, tree_.node_count)``: 1 where sample
         ``i`` passes through node ``j`` (`X` as for `apply`)."""
         check_is_fitted(self)
         return self._decision_path(X, [self.tree_])[0]
 
-    def get_depth(self):
+    def get_depth(self) -> int:
         """Length of the longest root-to-leaf path."""
         check_is_fitted(self)
         return self.tree_.max_depth
 
-    def get_n_leaves(self):
+    def get_n_leaves(self) -> int:
         """Number of leaves."""
         check_is_fitted(self)
         return self.tree_.n_leaves
 
     @property
-    def feature_importances_(self):
+    def feature_importances_(self) -> np.ndarray:
         """Impurity-based importance of each type of ``types_`` (each column for a feature
         matrix), summing to 1 (all zeros for a single leaf), shape (``n_types_``,)."""
         check_is_fitted(self)

@@ -1,10 +1,15 @@
 """Extra-Trees forests whose node tests count objects in boxes: ``BoxExtraTreesRegressor``
 and ``BoxExtraTreesClassifier``."""
+from __future__ import annotations
+
 import warnings
+from collections.abc import Callable, Iterator, Sequence
 from numbers import Integral
+from typing import Any, Literal, Self
 
 import numpy as np
-from sklearn.base import _fit_context
+from numpy.typing import ArrayLike
+from scipy.sparse import csr_matrix
 from sklearn.metrics import r2_score
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval, RealNotInt, StrOptions
@@ -12,6 +17,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from ._base import _INT32_MAX, BaseBoxTrees, ClassificationTargets, RegressionTargets, _Bootstrap
 from ._extra_tree import _SEED_MAX, BoxExtraTreeClassifier, BoxExtraTreeRegressor
+from ._typing import RandomStateLike, SetsOrMatrix, TestType, fit_context
 
 __all__ = ["BoxExtraTreesClassifier", "BoxExtraTreesRegressor"]
 
@@ -33,6 +39,8 @@ def _same(a, b):
 class _Forest(BaseBoxTrees):
     """Fitting and walking a forest of trees of class ``_tree_class``."""
 
+    estimators_: list[BoxExtraTreeRegressor | BoxExtraTreeClassifier]
+
     _parameter_constraints = {
         **BaseBoxTrees._parameter_constraints,
         "n_estimators": [Interval(Integral, 1, _INT32_MAX, closed="both")],
@@ -51,26 +59,26 @@ class _Forest(BaseBoxTrees):
 
     def __init__(
         self,
-        n_estimators=30,
+        n_estimators: int = 30,
         *,
-        n_tests=500,
-        min_samples_split=30,
-        test_type="random",
-        test_width=0.1,
-        max_retries=10,
-        max_depth=None,
-        view_bounds=None,
-        column_groups=None,
-        relative_width=True,
-        refine_tests=True,
-        bootstrap=True,
-        oob_score=False,
-        max_samples=None,
-        warm_start=False,
-        n_jobs=None,
-        random_state=None,
-        verbose=0,
-    ):
+        n_tests: int = 500,
+        min_samples_split: int | float = 30,
+        test_type: TestType = "random",
+        test_width: float = 0.1,
+        max_retries: int = 10,
+        max_depth: int | None = None,
+        view_bounds: ArrayLike | float | None = None,
+        column_groups: Sequence[int | Sequence[int]] | None = None,
+        relative_width: bool = True,
+        refine_tests: bool = True,
+        bootstrap: bool = True,
+        oob_score: bool | Callable[[np.ndarray, np.ndarray], float] = False,
+        max_samples: int | float | None = None,
+        warm_start: bool = False,
+        n_jobs: int | None = None,
+        random_state: RandomStateLike = None,
+        verbose: int = 0,
+    ) -> None:
         self.n_estimators = n_estimators
         self.n_tests = n_tests
         self.min_samples_split = min_samples_split
@@ -90,8 +98,8 @@ class _Forest(BaseBoxTrees):
         self.random_state = random_state
         self.verbose = verbose
 
-    @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y, sample_weight=None):
+    @fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X: SetsOrMatrix, y: ArrayLike, sample_weight: ArrayLike | None = None) -> Self:
         """Grow the forest (with ``warm_start``, only the trees it does not have yet).
 
         Parameters
@@ -226,7 +234,7 @@ class _Forest(BaseBoxTrees):
     def _trees(self):
         return [e.tree_ for e in self.estimators_] if "estimators_" in self.__dict__ else None
 
-    def apply(self, X):
+    def apply(self, X: SetsOrMatrix) -> np.ndarray:
         """Index of the leaf each sample reaches in each tree.
 
         Parameters
@@ -240,7 +248,7 @@ class _Forest(BaseBoxTrees):
         """
         return self._apply(X, self.n_jobs)
 
-    def decision_path(self, X):
+    def decision_path(self, X: SetsOrMatrix) -> tuple[csr_matrix, np.ndarray]:
         """The nodes each sample passes through, in every tree.
 
         Parameters
@@ -258,7 +266,7 @@ class _Forest(BaseBoxTrees):
         return self._decision_path(X, self._trees(), self.n_jobs)
 
     @property
-    def feature_importances_(self):
+    def feature_importances_(self) -> np.ndarray:
         """Impurity-based importance of each type of ``types_`` (each column for a feature
         matrix): the weighted variance reduction of the tests on it, normalised per tree,
         averaged over trees, summing to 1 (all zeros if no tree splits).
@@ -271,15 +279,15 @@ class _Forest(BaseBoxTrees):
         total = np.mean([t.type_importances(self.types_) for t in self._trees()], axis=0)
         return total / total.sum() if total.sum() > 0 else total
 
-    def __len__(self):
+    def __len__(self) -> int:
         """Number of fitted trees."""
         return len(self.estimators_)
 
-    def __getitem__(self, index):
+    def __getitem__(self, index: int) -> BoxExtraTreeRegressor | BoxExtraTreeClassifier:
         """The ``index``-th fitted tree."""
         return self.estimators_[index]
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[BoxExtraTreeRegressor | BoxExtraTreeClassifier]:
         return iter(self.estimators_)
 
 
@@ -522,27 +530,28 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
 
     def __init__(
         self,
-        n_estimators=30,
+        n_estimators: int = 30,
         *,
-        n_tests=500,
-        min_samples_split=30,
-        test_type="random",
-        test_width=0.1,
-        max_retries=10,
-        max_depth=None,
-        view_bounds=None,
-        column_groups=None,
-        relative_width=True,
-        refine_tests=True,
-        bootstrap=True,
-        oob_score=False,
-        max_samples=None,
-        warm_start=False,
-        class_weight=None,
-        n_jobs=None,
-        random_state=None,
-        verbose=0,
-    ):
+        n_tests: int = 500,
+        min_samples_split: int | float = 30,
+        test_type: TestType = "random",
+        test_width: float = 0.1,
+        max_retries: int = 10,
+        max_depth: int | None = None,
+        view_bounds: ArrayLike | float | None = None,
+        column_groups: Sequence[int | Sequence[int]] | None = None,
+        relative_width: bool = True,
+        refine_tests: bool = True,
+        bootstrap: bool = True,
+        oob_score: bool | Callable[[np.ndarray, np.ndarray], float] = False,
+        max_samples: int | float | None = None,
+        warm_start: bool = False,
+        class_weight: (Literal["balanced", "balanced_subsample"] | dict[Any, float]
+                       | list[dict[Any, float]] | None) = None,
+        n_jobs: int | None = None,
+        random_state: RandomStateLike = None,
+        verbose: int = 0,
+    ) -> None:
         super().__init__(
             n_estimators, n_tests=n_tests, min_samples_split=min_samples_split,
             test_type=test_type, test_width=test_width, max_retries=max_retries,

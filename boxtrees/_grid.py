@@ -1,12 +1,18 @@
 """The grid representation of object sets: per-type object counts in the cells of a grid."""
+from __future__ import annotations
+
+from collections.abc import Sequence
 from numbers import Integral, Real
+from typing import Self
 
 import numpy as np
-from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
+from numpy.typing import ArrayLike
+from sklearn.base import BaseEstimator, TransformerMixin
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import _check_feature_names_in, check_is_fitted
 
 from ._objects import _MAX_TYPE, ObjectInputMixin, check_view_bounds, columns_of, fitted_region
+from ._typing import SetsOrMatrix, fit_context
 
 __all__ = ["GridCounts"]
 
@@ -75,22 +81,23 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         "columns": [tuple, list, None],
     }
 
-    def __init__(self, n_bins=10, *, view_bounds=None, n_types=None, columns=None):
+    def __init__(self, n_bins: int = 10, *, view_bounds: ArrayLike | float | None = None,
+                 n_types: int | None = None, columns: Sequence[int] | None = None) -> None:
         self.n_bins = n_bins
         self.view_bounds = view_bounds
         self.n_types = n_types
         self.columns = columns
 
-    @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y=None):
+    @fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X: SetsOrMatrix, y: object = None) -> Self:
         """Learn the grid extent and the number of types.
 
         Parameters
         ----------
         X : sequence of array-like of shape (n_i, d + 1), ObjectSets, or array of shape (n_samples, n_features)
             Object sets, or a feature matrix.
-        y : None
-            Ignored.
+        y : Ignored
+            Not used, present for API consistency by convention.
 
         Returns
         -------
@@ -130,7 +137,7 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         """Cells along x and y (one along y for a grid over one column)."""
         return self.n_bins, (self.n_bins if len(self.columns_) == 2 else 1)
 
-    def transform(self, X):
+    def transform(self, X: SetsOrMatrix) -> np.ndarray:
         """Count objects per cell and type.
 
         Parameters
@@ -158,7 +165,7 @@ class GridCounts(ObjectInputMixin, TransformerMixin, BaseEstimator):
         counts = np.bincount(index[inside], minlength=len(sets) * n_out)
         return counts.reshape(len(sets), n_out).astype(np.float64)
 
-    def get_feature_names_out(self, input_features=None):
+    def get_feature_names_out(self, input_features: ArrayLike | None = None) -> np.ndarray:
         """Names of the output counts: ``"type{t}_x{i}_y{j}"`` (``"{feature}_bin{i}"`` for
         a feature matrix).
 

@@ -1,15 +1,21 @@
 """What the objects of each type, and of each region, contribute to a fitted estimator's
 score: `type_importance` and `region_importance`, the object-set counterparts of
 scikit-learn's ``permutation_importance`` (which reads ``X`` as a feature matrix)."""
+from __future__ import annotations
+
+from collections.abc import Callable
 from numbers import Integral, Real
+from typing import Any, Literal, Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 from sklearn.metrics import check_scoring
 from sklearn.utils import Bunch, check_random_state
-from sklearn.utils._param_validation import HasMethods, Interval, StrOptions, validate_params
+from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
 
 from ._objects import (ObjectSets, _offsets_from_sizes, as_object_sets, check_view_bounds,
                        fitted_region, is_feature_matrix)
+from ._typing import ObjectSetsInput, RandomStateLike, validate_params
 
 __all__ = ["region_importance", "type_importance"]
 
@@ -23,6 +29,12 @@ _COMMON = {
     "sample_weight": ["array-like", None],
     "random_state": ["random_state"],
 }
+
+
+class _Predictor(Protocol):
+    """A fitted estimator: anything with ``predict``."""
+
+    def predict(self, X: Any, /) -> Any: ...
 
 
 class _Scores:
@@ -70,8 +82,12 @@ class _Scores:
     {**_COMMON, "method": [StrOptions({"permute", "drop"})]},
     prefer_skip_nested_validation=True,
 )
-def type_importance(estimator, X, y, *, method="permute", types=None, scoring=None,
-                    n_repeats=5, sample_weight=None, random_state=None):
+def type_importance(estimator: _Predictor, X: ObjectSetsInput, y: ArrayLike, *,
+                    method: Literal["permute", "drop"] = "permute",
+                    types: ArrayLike | None = None,
+                    scoring: str | Callable[..., float] | None = None, n_repeats: int = 5,
+                    sample_weight: ArrayLike | None = None,
+                    random_state: RandomStateLike = None) -> Bunch:
     """Importance of each object type: the loss of score when the objects of one type are
     shuffled between the samples, or removed.
 
@@ -163,8 +179,12 @@ def type_importance(estimator, X, y, *, method="permute", types=None, scoring=No
      "method": [StrOptions({"drop", "move"})], "extent": ["array-like", Real, None]},
     prefer_skip_nested_validation=True,
 )
-def region_importance(estimator, X, y, *, n_bins=4, method="drop", types=None, extent=None,
-                      scoring=None, n_repeats=5, sample_weight=None, random_state=None):
+def region_importance(estimator: _Predictor, X: ObjectSetsInput, y: ArrayLike, *,
+                      n_bins: int = 4, method: Literal["drop", "move"] = "drop",
+                      types: ArrayLike | None = None, extent: ArrayLike | float | None = None,
+                      scoring: str | Callable[..., float] | None = None, n_repeats: int = 5,
+                      sample_weight: ArrayLike | None = None,
+                      random_state: RandomStateLike = None) -> Bunch:
     """Importance of each region, per object type: a map over a grid of cells on the
     objects' first two attributes (a position), each cell's value the loss of score when
     the objects of that type in the cell are removed, or moved out of it.

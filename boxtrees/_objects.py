@@ -5,10 +5,15 @@ velocity...) and a non-negative integer type id, last. A sample is a set of obje
 empty). A batch of samples is stored as one ``(n_objects, d + 1)`` float32 array plus offsets,
 so it is cheap to build, slice and hand to the Cython core.
 """
+from __future__ import annotations
+
 import warnings
+from collections.abc import Iterable, Iterator, Sequence
 from numbers import Integral
+from typing import Any, NoReturn, Protocol, Self, overload
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.sparse import issparse
 
 from ._rows import MAX_TYPE as _MAX_TYPE
@@ -18,6 +23,12 @@ __all__ = ["ObjectSets"]
 
 _FLOAT32_MAX = float(np.finfo(np.float32).max)
 _DEFAULT_WIDTH = 3  # the columns of a batch with no object at all: [x, y, type]
+
+
+class _Frame(Protocol):
+    """A table read by column name: a data frame, or a mapping of names to columns."""
+
+    def __getitem__(self, name: str, /) -> Any: ...
 
 
 def _offsets_from_sizes(sizes):
@@ -167,21 +178,27 @@ class ObjectSets:
     """
 
     __slots__ = ("data", "offsets", "type_names")
+    data: np.ndarray
+    offsets: np.ndarray
+    type_names: np.ndarray | None
 
-    def __init__(self, data, offsets, type_names=None):
+    def __init__(self, data: ArrayLike, offsets: ArrayLike,
+                 type_names: ArrayLike | None = None) -> None:
         self.data = _check_rows(data)
         self.offsets = _check_offsets(offsets, len(self.data))
         self.type_names = _check_type_names(type_names, self.data)
 
     @classmethod
-    def _trusted(cls, data, offsets, type_names=None):
+    def _trusted(cls, data: np.ndarray, offsets: np.ndarray,
+                 type_names: np.ndarray | None = None) -> Self:
         """Wrap arrays that are already valid (internal: no checks, no copies)."""
         self = cls.__new__(cls)
         self.data, self.offsets, self.type_names = data, offsets, type_names
         return self
 
     @classmethod
-    def from_frame(cls, frame, *, sample, columns, type, samples=None):
+    def from_frame(cls, frame: _Frame, *, sample: str, columns: Sequence[str], type: str,
+                   samples: ArrayLike | None = None) -> Self:
         """Build from a long table, one row per object: a data frame, or any mapping from
         column names to equal-length columns (pandas, polars, a dict of arrays).
 
@@ -269,7 +286,7 @@ class ObjectSets:
         return cls(data.reshape(-1, len(columns) + 1), _offsets_from_sizes(sizes), type_names)
 
     @classmethod
-    def from_sequence(cls, sets):
+    def from_sequence(cls, sets: Sequence[ArrayLike]) -> Self:
         """Build from a sequence of ``(n_i, d + 1)`` arrays (empty sets allowed).
 
         Parameters
@@ -287,7 +304,7 @@ class ObjectSets:
             if data.size == 0 or (data.ndim == 2 and data.shape[1] >= 2):
                 data = _check_rows(data)
                 return cls._trusted(data, np.array([0, len(data)], dtype=np.intp))
-        arrays, width, first = [], None, None
+        arrays, first = [], None    # first: the position and shape of the first non-empty set
         for i, s in enumerate(sets):
             if s is None:
                 raise ValueError(f"each object set must be an array of shape (n_objects, d + 1); "
@@ -301,25 +318,25 @@ class ObjectSets:
                     f"each object set must have shape (n_objects, d + 1) with columns "
                     f"[f_1, ..., f_d, type], d >= 1; set {i} has shape {a.shape}"
                 )
-            if width is None:
-                width, first = a.shape[1], (i, a.shape)
-            elif a.shape[1] != width:
+            if first is None:
+                first = (i, a.shape)
+            elif a.shape[1] != first[1][1]:
                 raise ValueError(
                     f"every object set must have the same columns [f_1, ..., f_d, type]; set "
                     f"{first[0]} has shape {first[1]} but set {i} has shape {a.shape}"
                 )
             arrays.append(a)
-        if width is None:   # no object at all: the empty sets' width, if they agree
+        if first is None:   # no object at all: the empty sets' width, if they agree
             widths = {_empty_width(a) for a in arrays}
-            width = widths.pop() if len(widths) == 1 else _DEFAULT_WIDTH
+            data = np.empty((0, widths.pop() if len(widths) == 1 else _DEFAULT_WIDTH))
+        else:
+            data = np.concatenate([a for a in arrays if a.size])
         sizes = np.fromiter((len(a) if a.size else 0 for a in arrays), dtype=np.intp,
                             count=len(arrays))
-        data = np.concatenate([a for a in arrays if a.size]) if sizes.any() else \
-            np.empty((0, width))
         return cls._trusted(_check_rows(data), _offsets_from_sizes(sizes))
 
     @classmethod
-    def from_features(cls, X):
+    def from_features(cls, X: ArrayLike) -> Self:
         """Read a 2D feature matrix as object sets: column ``j`` is one object of type ``j``.
 
         The value is the object's one attribute (as float32): rows ``[value, type]``, d = 1.
@@ -371,7 +388,7 @@ class ObjectSets:
         return cls._trusted(data, _offsets_from_sizes(np.full(n_samples, n_features)))
 
     @classmethod
-    def from_padded(cls, array, mask):
+    def from_padded(cls, array: ArrayLike, mask: ArrayLike) -> Self:
         """Build from padded rows: sample ``i`` is the rows ``array[i, j]`` where
         ``mask[i, j]`` is true, in order.
 
@@ -412,7 +429,7 @@ class ObjectSets:
         return cls._trusted(data, _offsets_from_sizes(mask.sum(axis=1)))
 
     @classmethod
-    def concatenate(cls, batches):
+    def concatenate(cls, batches: Iterable[ObjectSets]) -> Self:
         """Join several batches into one, set order preserved.
 
         Each batch is checked as the constructor checks its arguments (its arrays may have
@@ -479,27 +496,33 @@ class ObjectSets:
         return cls._trusted(np.concatenate(data), _offsets_from_sizes(np.concatenate(sizes)),
                             names)
 
-    def __len__(self):
+    def __len__(self) -> int:
         return len(self.offsets) - 1
 
     @property
-    def sizes(self):
+    def sizes(self) -> np.ndarray:
         """Number of objects of each set, shape (n_sets,)."""
         return np.diff(self.offsets)
 
     @property
-    def n_objects(self):
+    def n_objects(self) -> int:
         """Total number of objects."""
         return len(self.data)
 
     @property
-    def n_attributes(self):
+    def n_attributes(self) -> int:
         """Number of attributes of each object (``d``: its columns but the type)."""
         return self.data.shape[1] - 1
 
-    def sample_index(self):
+    def sample_index(self) -> np.ndarray:
         """The set each object row belongs to, shape (n_objects,)."""
         return np.repeat(np.arange(len(self), dtype=np.intp), self.sizes)
+
+    @overload
+    def __getitem__(self, index: int | np.integer) -> np.ndarray: ...
+
+    @overload
+    def __getitem__(self, index: slice | Sequence[int] | np.ndarray) -> ObjectSets: ...
 
     def __getitem__(self, index):
         """``sets[i]`` is the ``(n_i, d + 1)`` array of set ``i`` (a view); slices, integer arrays
@@ -533,15 +556,15 @@ class ObjectSets:
         rows = np.repeat(starts - offsets[:-1], sizes) + np.arange(offsets[-1])
         return ObjectSets._trusted(self.data[rows], offsets, self.type_names)
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[np.ndarray]:
         for i in range(len(self)):
             yield self.data[self.offsets[i] : self.offsets[i + 1]]
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return (f"ObjectSets(n_sets={len(self)}, n_objects={self.n_objects}, "
                 f"n_attributes={self.n_attributes})")
 
-    def __array__(self, dtype=None, copy=None):
+    def __array__(self, dtype: object = None, copy: bool | None = None) -> NoReturn:
         """Refused: a batch of sets is no array of features. scikit-learn's
         ``permutation_importance`` converts ``X`` with NumPy, and gets this error rather than
         one from inside NumPy."""
@@ -552,10 +575,10 @@ class ObjectSets:
             "boxtrees.region_importance measure what the objects of each type, and of each "
             "region, bring to a score")
 
-    def __getstate__(self):
+    def __getstate__(self) -> dict[str, Any]:
         return {"data": self.data, "offsets": self.offsets, "type_names": self.type_names}
 
-    def __setstate__(self, state):
+    def __setstate__(self, state: dict[str, Any]) -> None:
         self.data, self.offsets = state["data"], state["offsets"]
         self.type_names = state.get("type_names")
 

@@ -6,7 +6,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 __all__ = ["thread_pool"]
 
-_POOLS = {}  # (purpose, threads) -> the pool of this process
+# (purpose, threads) -> the pool of this process
+_POOLS: dict[tuple[str, int], ThreadPoolExecutor] = {}
 _POOLS_LOCK = threading.Lock()
 
 
@@ -21,7 +22,7 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_forget_pools_after_fork)
 
 
-def thread_pool(n_threads, purpose="boxtrees-predict"):
+def thread_pool(n_threads: int, purpose: str = "boxtrees-predict") -> ThreadPoolExecutor:
     """The process's pool of `n_threads` threads for `purpose`, started on first use.
 
     Predictions are called once per environment step on batches of a few hundred samples,

@@ -1,5 +1,11 @@
 """Fitted box-test trees as flat node arrays."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Self
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._builder import NODE_FIELDS
 from ._rows import TREE_LEAF, TREE_UNDEFINED
@@ -43,7 +49,17 @@ class BoxTree:
     (or unpickled, which validates them again); build a new ``BoxTree`` to change one.
     """
 
-    def __init__(self, **arrays):
+    children_left: np.ndarray
+    children_right: np.ndarray
+    object_type: np.ndarray
+    box: np.ndarray
+    threshold: np.ndarray
+    value: np.ndarray
+    impurity: np.ndarray
+    n_node_samples: np.ndarray
+    weighted_n_node_samples: np.ndarray
+
+    def __init__(self, **arrays: ArrayLike) -> None:
         missing = set(_FIELDS) - set(arrays)
         if missing:
             raise TypeError(f"missing node arrays: {sorted(missing)}")
@@ -53,7 +69,8 @@ class BoxTree:
             setattr(self, name, array)
 
     @classmethod
-    def from_builder(cls, arrays, types, column_groups, n_attributes):
+    def from_builder(cls, arrays: dict[str, np.ndarray], types: np.ndarray,
+                     column_groups: Sequence[Sequence[int]], n_attributes: int) -> Self:
         """A tree from the builder's arrays, whose tested types are positions in ``types`` and
         whose boxes span the columns of ``column_groups[group]`` (x, then y if any)."""
         inner = arrays["children_left"] != TREE_LEAF
@@ -70,7 +87,7 @@ class BoxTree:
         return cls(**arrays)
 
     @property
-    def n_attributes(self):
+    def n_attributes(self) -> int:
         """Number of object attributes the boxes bound (``d``)."""
         return self.box.shape[1] // 2
 
@@ -78,21 +95,21 @@ class BoxTree:
         self.__init__(**state)
 
     @property
-    def node_count(self):
+    def node_count(self) -> int:
         """Number of nodes."""
         return len(self.value)
 
     @property
-    def n_leaves(self):
+    def n_leaves(self) -> int:
         """Number of leaves."""
         return int((self.children_left == TREE_LEAF).sum())
 
     @property
-    def max_depth(self):
+    def max_depth(self) -> int:
         """Length of the longest root-to-leaf path."""
         return int(self.node_depth().max())
 
-    def parents(self):
+    def parents(self) -> np.ndarray:
         """Parent of every node (-1 at the root), shape (node_count,)."""
         parent = np.full(self.node_count, TREE_LEAF, dtype=np.intp)
         inner = np.flatnonzero(self.children_left != TREE_LEAF)
@@ -100,7 +117,7 @@ class BoxTree:
         parent[self.children_right[inner]] = inner
         return parent
 
-    def node_depth(self):
+    def node_depth(self) -> np.ndarray:
         """Depth of every node (root 0), shape (node_count,)."""
         depth = np.zeros(self.node_count, dtype=np.intp)
         parent = self.parents()
@@ -109,7 +126,7 @@ class BoxTree:
             depth[node] = depth[parent[node]] + 1
         return depth
 
-    def split_gains(self):
+    def split_gains(self) -> np.ndarray:
         """Each node's weighted impurity decrease, ``w_n i_n - w_l i_l - w_r i_r`` (``w``: the
         weighted samples reaching a node, ``i``: its impurity; ``l``, ``r``: its children),
         0 at the leaves, shape (node_count,): what its test gains, in the units of the
@@ -136,7 +153,7 @@ class BoxTree:
                         - weight[right] * impurity[right])
         return gains
 
-    def type_importances(self, types):
+    def type_importances(self, types: np.ndarray) -> np.ndarray:
         """Weighted variance reduction of the tests on each of ``types`` (sorted type ids),
         normalised to sum to 1 (all zeros for a single-leaf tree), shape (len(types),)."""
         inner = np.flatnonzero(self.children_left != TREE_LEAF)
@@ -148,5 +165,5 @@ class BoxTree:
         total = np.bincount(position, weights=decrease, minlength=len(types))
         return total / total.sum() if total.sum() > 0 else total
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"BoxTree(node_count={self.node_count}, n_leaves={self.n_leaves})"
