@@ -14,17 +14,24 @@ plus the baselines of the thesis.
 
 `fqi` talks to its env through gymnasium's API only and knows no particular game.
 """
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 from ._agent import FQI
 from ._baselines import make_box_forest, make_grid_ridge
 from ._evaluate import Evaluation, RandomPolicy, evaluate
 from ._logger import CSVLogger
 from ._wrappers import GridObservation
 
+if TYPE_CHECKING:
+    from ._set_encoder import SetEncoder
+
 __all__ = ["FQI", "evaluate", "Evaluation", "RandomPolicy", "GridObservation",
            "make_box_forest", "make_grid_ridge", "CSVLogger", "SetEncoder"]
 
 
-def __getattr__(name):
+def __getattr__(name: str) -> type[SetEncoder]:
     if name == "SetEncoder":    # torch is imported only by those who use it
         from ._set_encoder import SetEncoder
 

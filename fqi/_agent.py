@@ -1,9 +1,15 @@
 """`FQI`: fitted Q-iteration with one scikit-learn regressor per action, on any gymnasium env."""
+from __future__ import annotations
+
 import inspect
+import os
 import time
+from collections.abc import Sequence
 from contextlib import contextmanager
+from typing import Any, Self
 
 import numpy as np
+from gymnasium import spaces
 from gymnasium.vector import VectorEnv
 from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
@@ -21,6 +27,7 @@ from ._logger import CSVLogger, _KeyValueLogger
 from ._observations import _ObjectRows, _observation_format
 from ._q_function import _checked_prediction, _QFunction
 from ._saving import _read_save, _write_save
+from ._typing import Callback, Dataset, EnvLike, Logger, Observation, Regressor
 
 __all__ = ["FQI"]
 
@@ -154,7 +161,9 @@ class FQI:
         gymnasium's next-step autoreset are not transitions and not counted).
     iteration : int
         Iterations done so far.
-    observation_space, action_space : gymnasium.spaces.Space
+    observation_space : gymnasium.spaces.Space
+        Of one env.
+    action_space : gymnasium.spaces.Discrete
         Of one env.
     n_actions : int
         Number of actions (``action_space.n``): one Q-function each.
@@ -175,18 +184,32 @@ class FQI:
     True
     """
 
-    def __init__(self, regressor, env, gamma=0.99, samples_per_iteration=2_500,
-                 resample_every=5, keep_data=True, max_samples=100_000,
-                 exploration_fraction=0.1, exploration_initial_eps=1.0,
-                 exploration_final_eps=0.05, n_envs=None, eval_episodes=None,
-                 eval_seeds=None, eval_env=None, n_jobs=1, log_path=None, seed=None,
-                 verbose=0):
+    exploration_rate: float
+    history: list[dict[str, Any]]
+    num_timesteps: int
+    iteration: int
+    observation_space: spaces.Space
+    action_space: spaces.Discrete
+    n_actions: int
+    _collector: _Collector | None
+    _logger: Logger | None
+
+    def __init__(self, regressor: Regressor, env: EnvLike, gamma: float = 0.99,
+                 samples_per_iteration: int = 2_500, resample_every: int | None = 5,
+                 keep_data: bool = True, max_samples: int = 100_000,
+                 exploration_fraction: float = 0.1, exploration_initial_eps: float = 1.0,
+                 exploration_final_eps: float = 0.05, n_envs: int | None = None,
+                 eval_episodes: int | None = None, eval_seeds: Sequence[int] | None = None,
+                 eval_env: EnvLike | None = None, n_jobs: int = 1,
+                 log_path: str | os.PathLike[str] | None = None, seed: int | None = None,
+                 verbose: int | bool = 0) -> None:
         self._set_params({name: value for name, value in locals().items() if name != "self"})
         world_seq, action_seq, fit_seq = np.random.SeedSequence(self.seed).spawn(3)
         self._world_rng = np.random.default_rng(world_seq)
         self._action_rng = np.random.default_rng(action_seq)
         self._fit_rng = np.random.default_rng(fit_seq)
-        self.observation_space = self.action_space = None
+        # None until set_env (below) sets them: afterwards always the env's spaces
+        self.observation_space = self.action_space = None  # type: ignore[assignment]
         self.exploration_rate = self.exploration_initial_eps
         self._q = None  # the last iteration's _QFunction
         self.history = []
@@ -241,7 +264,7 @@ class FQI:
         self._csv_log = None if self.log_path is None else CSVLogger(self.log_path)
 
     # ------------------------------------------------------------------ envs
-    def set_env(self, env, eval_env=None):
+    def set_env(self, env: EnvLike, eval_env: EnvLike | None = None) -> None:
         """Play on `env` from now on (its spaces must be the agent's, once it has some).
 
         Builds the training vector env and the evaluation one (from `eval_env`, else from
@@ -313,16 +336,16 @@ class FQI:
                             lambda: f"{self.regressor!r}, fitted on the env's first "
                                     f"observations,")
 
-    def get_env(self):
+    def get_env(self) -> VectorEnv | None:
         """The training vector env (None for an agent loaded without an env)."""
         return self._env
 
-    def get_vec_normalize_env(self):
+    def get_vec_normalize_env(self) -> None:
         """None: FQI normalizes no observations (stable-baselines3's callbacks ask)."""
         return None
 
     @property
-    def logger(self):
+    def logger(self) -> Logger:
         """The key-value logger that stable-baselines3 callbacks write to
         (``self.logger.record`` in a callback). Each iteration records its `history`
         record in it, every key prefixed with ``fqi/``, and dumps it at `num_timesteps`.
@@ -333,7 +356,7 @@ class FQI:
             self._logger = _KeyValueLogger()
         return self._logger
 
-    def set_logger(self, logger):
+    def set_logger(self, logger: Logger) -> None:
         """Log to `logger` from now on, as stable-baselines3's ``set_logger``.
 
         Parameters
@@ -351,8 +374,8 @@ class FQI:
         self._logger = logger
 
     # ------------------------------------------------------------------ training
-    def learn(self, total_timesteps=None, callback=None, progress_bar=False, *,
-              n_iterations=None):
+    def learn(self, total_timesteps: int | None = None, callback: Callback | None = None,
+              progress_bar: bool = False, *, n_iterations: int | None = None) -> Self:
         """Train for `total_timesteps` more environment steps, or `n_iterations` more
         iterations (continuing from earlier calls).
 
@@ -400,7 +423,8 @@ class FQI:
             self._collector = _Collector(self._env, self._observations, self._world_rng)
         return self._train(callback, progress_bar, total_timesteps, n_iterations)
 
-    def learn_offline(self, dataset, n_iterations, callback=None, progress_bar=False):
+    def learn_offline(self, dataset: Dataset, n_iterations: int,
+                      callback: Callback | None = None, progress_bar: bool = False) -> Self:
         """Fitted Q-iteration on a fixed data set, without playing the env: FQI as first
         formulated, and as offline reinforcement learning works.
 
@@ -579,7 +603,7 @@ class FQI:
                         q.argmax(axis=1))
 
     # ------------------------------------------------------------------ acting
-    def q_values(self, observation):
+    def q_values(self, observation: Observation) -> np.ndarray:
         """Q-values of every action.
 
         Parameters
@@ -601,11 +625,13 @@ class FQI:
         return self._q.values(batch, self.n_jobs)
 
     @property
-    def q_functions_(self):
+    def q_functions_(self) -> list[Regressor] | None:
         """The fitted ``Q_n``, one regressor per action (None before the first iteration)."""
         return None if self._q is None else self._q.models
 
-    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+    def predict(self, observation: Observation, state: object = None,
+                episode_start: object = None, deterministic: bool = True
+                ) -> tuple[np.integer | np.ndarray, None]:
         """Actions for one observation or a batch (the stable-baselines3 signature).
 
         Parameters
@@ -625,7 +651,7 @@ class FQI:
 
         Returns
         -------
-        actions : int, or ndarray of int of shape (batch,)
+        actions : numpy int, or ndarray of int of shape (batch,)
         state : None
         """
         batch, single = self._observations.as_input(observation)
@@ -634,7 +660,7 @@ class FQI:
         return (actions[0] if single else actions), None
 
     # ------------------------------------------------------------------ persistence
-    def save(self, path):
+    def save(self, path: str | os.PathLike[str]) -> None:
         """Save the agent with joblib: its attributes (every constructor parameter, the
         fitted Q-functions, the history, the spaces and the random streams), less the envs,
         the transitions, the threads and the open log. An env given by its id is saved as
@@ -651,7 +677,8 @@ class FQI:
         _write_save(state, path)
 
     @classmethod
-    def load(cls, path, env=None, **params):
+    def load(cls, path: str | os.PathLike[str], env: EnvLike | None = None,
+             **params: Any) -> Self:
         """Load an agent saved by `save`.
 
         Loading unpickles the file, which can run arbitrary code: load only trusted files.
@@ -692,7 +719,7 @@ class FQI:
             agent.set_env(env)
         return agent
 
-    def __getstate__(self):
+    def __getstate__(self) -> dict[str, Any]:
         """The agent's attributes for pickle: with its envs (an env that does not pickle
         makes the agent unpicklable) and random streams, so an unpickled agent learns on
         exactly as this one would; less the transitions when the next
@@ -704,7 +731,7 @@ class FQI:
             state["_data"] = None
         return state
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return (f"FQI(regressor={self.regressor!r}, gamma={self.gamma}, "
                 f"samples_per_iteration={self.samples_per_iteration}, "
                 f"resample_every={self.resample_every}, keep_data={self.keep_data}, "

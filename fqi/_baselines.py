@@ -1,21 +1,29 @@
 """The regressors compared in the thesis: its box forest and grid counts with a ridge."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
 import gymnasium as gym
 import numpy as np
 from sklearn.base import clone
 from sklearn.linear_model import Ridge
-from sklearn.pipeline import make_pipeline
+from sklearn.pipeline import Pipeline, make_pipeline
 
 from boxtrees import BoxExtraTreesRegressor, GridCounts
+from boxtrees._typing import RandomStateLike, TestType
 
 from ._checks import _check_int, _check_n_jobs, _check_real
 from ._envs import _spaces
 from ._observations import _object_bounds, _view_bounds
+from ._typing import EnvLike
 
 __all__ = ["make_box_forest", "make_grid_ridge"]
 
-def make_box_forest(env=None, *, test_type="fixed", test_width=1.0, n_estimators=30,
-                    n_tests=500, min_samples_split=30, n_jobs=-1, random_state=None,
-                    view_bounds=None):
+def make_box_forest(env: EnvLike | None = None, *, test_type: TestType = "fixed",
+                    test_width: float = 1.0, n_estimators: int = 30, n_tests: int = 500,
+                    min_samples_split: int | float = 30, n_jobs: int | None = -1,
+                    random_state: RandomStateLike = None,
+                    view_bounds: Sequence[float] | None = None) -> BoxExtraTreesRegressor:
     """A `boxtrees.BoxExtraTreesRegressor` drawing its tests in the env's view square.
 
     The thesis's forest: its tuned parameters are the defaults (M=30, K=500, n_min=30, fixed
@@ -65,7 +73,9 @@ def make_box_forest(env=None, *, test_type="fixed", test_width=1.0, n_estimators
     return forest
 
 
-def make_grid_ridge(env=None, *, n_bins=10, alpha=1.0, view_bounds=None, n_types=None):
+def make_grid_ridge(env: EnvLike | None = None, *, n_bins: int = 10, alpha: float = 1.0,
+                    view_bounds: Sequence[float] | None = None,
+                    n_types: int | None = None) -> Pipeline:
     """The thesis's grid representation: ``make_pipeline(GridCounts(n_bins), Ridge())``.
 
     Parameters

@@ -24,7 +24,7 @@ class _Transitions:
     rewards: np.ndarray
     next_states: object
     terminated: np.ndarray
-    next_values: np.ndarray = None
+    next_values: np.ndarray | None = None
 
     def __len__(self):
         return len(self.actions)

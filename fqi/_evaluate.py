@@ -1,4 +1,7 @@
 """Greedy play on fixed reset seeds: total and mean return, for any policy with ``predict``."""
+from __future__ import annotations
+
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -8,6 +11,7 @@ from ._checks import _check_int, _check_seed
 from ._envs import (_TRAINING_SEED_END, _autoreset_mode, _close_built, _make_vector,
                     _n_actions, _seeded_reset, _spaces)
 from ._observations import _observation_format
+from ._typing import EnvLike, Observation, Policy
 
 __all__ = ["evaluate", "Evaluation", "RandomPolicy"]
 
@@ -37,10 +41,11 @@ class Evaluation:
     std: float
     returns: np.ndarray
     lengths: np.ndarray
-    seeds: tuple
+    seeds: tuple[int, ...]
 
 
-def _eval_seeds(n_episodes, seeds, name="n_episodes", seeds_name="seeds"):
+def _eval_seeds(n_episodes: int | None, seeds: Sequence[int] | None, name: str = "n_episodes",
+                seeds_name: str = "seeds") -> tuple[int, ...]:
     """The reset seeds of an evaluation: `seeds` (checked, and `n_episodes` of them when
     both are given), else ``2**40, 2**40 + 1, ...``, `n_episodes` of them (default 10);
     none for ``n_episodes=0``."""
@@ -79,13 +84,15 @@ class RandomPolicy:
     (5,)
     """
 
-    def __init__(self, env, seed=None):
+    def __init__(self, env: EnvLike, seed: int | None = None) -> None:
         observation_space, action_space = _spaces(env)
         self.n_actions = _n_actions(action_space)
         self._observations = _observation_format(observation_space)
         self._rng = np.random.default_rng(_check_seed("seed", seed))
 
-    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+    def predict(self, observation: Observation, state: object = None,
+                episode_start: object = None, deterministic: bool = True
+                ) -> tuple[np.integer | np.ndarray, None]:
         """Uniform random actions: one for one observation, one per observation of a batch.
 
         Parameters
@@ -99,7 +106,7 @@ class RandomPolicy:
 
         Returns
         -------
-        actions : int or ndarray of int
+        actions : numpy int or ndarray of int
         state : None
         """
         batch, single = self._observations.as_input(observation)
@@ -108,7 +115,8 @@ class RandomPolicy:
         return self._rng.integers(self.n_actions, size=len(batch)), None
 
 
-def evaluate(policy, env, n_episodes=None, seeds=None):
+def evaluate(policy: Policy, env: EnvLike, n_episodes: int | None = None,
+             seeds: Sequence[int] | None = None) -> Evaluation:
     """Play one episode per reset seed with the policy's greedy actions.
 
     The episodes run side by side on a vector env (one env per episode; a given
@@ -160,17 +168,17 @@ def evaluate(policy, env, n_episodes=None, seeds=None):
     if not seeds:
         raise ValueError("n_episodes must be >= 1 (or give at least one seed)")
     vector = _make_vector(env, len(seeds))
-    returns, lengths = [], []
+    returns_by_round, lengths_by_round = [], []
     try:
         n_actions = _n_actions(vector.single_action_space)
         for start in range(0, len(seeds), vector.num_envs):
             round_returns, round_lengths = _play_round(policy, vector, n_actions,
                                                        seeds[start:start + vector.num_envs])
-            returns.append(round_returns)
-            lengths.append(round_lengths)
+            returns_by_round.append(round_returns)
+            lengths_by_round.append(round_lengths)
     finally:
         _close_built(vector, env)
-    returns, lengths = np.concatenate(returns), np.concatenate(lengths)
+    returns, lengths = np.concatenate(returns_by_round), np.concatenate(lengths_by_round)
     return Evaluation(float(returns.sum()), float(returns.mean()), float(returns.std()),
                       returns, lengths, seeds)
 

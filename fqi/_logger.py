@@ -1,8 +1,12 @@
 """FQI's logs: one CSV row per iteration (`CSVLogger`), and the key-value logger that
 stable-baselines3 callbacks write to (`_KeyValueLogger`, the default of `FQI.logger`)."""
+from __future__ import annotations
+
 import csv
 import os
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 __all__ = ["CSVLogger"]
 
@@ -21,7 +25,7 @@ class CSVLogger:
         must not be a directory (IsADirectoryError).
     """
 
-    def __init__(self, path):
+    def __init__(self, path: str | os.PathLike[str]) -> None:
         if not isinstance(path, (str, os.PathLike)):
             raise TypeError(f"the log path must be a str or path-like, got {path!r}")
         self.path = Path(path)
@@ -36,7 +40,7 @@ class CSVLogger:
             raise PermissionError(f"the log path {self.path} is not writable ({target} is "
                                   f"read-only)")
 
-    def write(self, record):
+    def write(self, record: Mapping[str, Any]) -> None:
         """Append one record as a row."""
         new = not self.path.exists() or self.path.stat().st_size == 0
         with self.path.open("a", newline="") as f:
@@ -45,7 +49,7 @@ class CSVLogger:
                 writer.writeheader()
             writer.writerow(record)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"CSVLogger({str(self.path)!r})"
 
 

@@ -1,4 +1,6 @@
 """`SetEncoder`: a stable-baselines3 features extractor for padded object sets."""
+from __future__ import annotations
+
 import numpy as np
 import torch
 from gymnasium import spaces
@@ -52,8 +54,8 @@ class SetEncoder(BaseFeaturesExtractor):
     4
     """
 
-    def __init__(self, observation_space, embed_dim=64, features_dim=128, attention=False,
-                 n_heads=4):
+    def __init__(self, observation_space: spaces.Box, embed_dim: int = 64,
+                 features_dim: int = 128, attention: bool = False, n_heads: int = 4) -> None:
         if not (isinstance(observation_space, spaces.Box) and len(observation_space.shape) == 2
                 and observation_space.shape[1] >= 3):
             raise ValueError(f"SetEncoder needs a Box observation space of shape (max_objects, "
@@ -84,7 +86,7 @@ class SetEncoder(BaseFeaturesExtractor):
                           if attention else None)
         self.head = nn.Sequential(nn.Linear(2 * embed_dim, features_dim), nn.ReLU())
 
-    def forward(self, observations):
+    def forward(self, observations: torch.Tensor) -> torch.Tensor:
         d = self.n_attributes
         valid = observations[..., d + 1] > 0.5                      # (batch, max_objects)
         types = observations[..., d].round().long().clamp(0, self.n_types - 1)

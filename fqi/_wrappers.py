@@ -1,11 +1,15 @@
 """A fixed-size grid observation, for agents that need a feature vector (SB3 DQN)."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
 from boxtrees import GridCounts
 
-from ._observations import _object_bounds
+from ._observations import _object_bounds, _row_box
 
 __all__ = ["GridObservation"]
 
@@ -53,14 +57,15 @@ class GridObservation(gym.ObservationWrapper):
     ((400,), np.float32(1.0))
     """
 
-    def __init__(self, env, n_bins=10, view_bounds=None, n_types=None):
+    def __init__(self, env: gym.Env, n_bins: int = 10, view_bounds: Sequence[float] | None = None,
+                 n_types: int | None = None) -> None:
         super().__init__(env)
         view_bounds, n_types = _object_bounds(env.observation_space, view_bounds, n_types)
-        width = env.observation_space.feature_space.shape[0]
+        width = _row_box(env.observation_space).shape[0]
         self.grid = GridCounts(n_bins, view_bounds=view_bounds,
                                n_types=n_types).fit([np.empty((0, width))])
         n_features = len(self.grid.get_feature_names_out())
         self.observation_space = spaces.Box(0.0, np.inf, shape=(n_features,), dtype=np.float32)
 
-    def observation(self, observation):
+    def observation(self, observation: np.ndarray) -> np.ndarray:
         return self.grid.transform([observation])[0].astype(np.float32)
