@@ -9,7 +9,8 @@ own discount factors; `SMALL_TASK_DQN` adapts LunarLander-v2's DQN settings to t
 """
 import copy
 
-__all__ = ["ZOO_DQN", "ZOO_PPO", "ZOO_STEPS", "SMALL_TASK_DQN", "without_gamma"]
+__all__ = ["ZOO_DQN", "ZOO_PPO", "ZOO_STEPS", "SMALL_TASK_DQN", "without_gamma",
+           "ATARI_DQN", "ATARI_PPO", "HIGHWAY_DQN", "HIGHWAY_PPO"]
 
 _LUNARLANDER = {
     "learning_rate": 6.3e-4, "batch_size": 128, "buffer_size": 50_000,
@@ -71,3 +72,26 @@ def without_gamma(env_id, table=None):
 # same settings, but bench_control.py trains Acrobot-v1 with rl-zoo3's unchanged.
 SMALL_TASK_DQN = {**without_gamma("LunarLander-v2"), "learning_starts": 1000,
                   "gradient_steps": 1}
+
+
+# rl-zoo3's settings for every Atari game (``atari`` in dqn.yml and ppo.yml; PPO's linear
+# schedules of the learning rate and the clip range as their initial values), less its
+# image pipeline (AtariWrapper, 4 stacked frames, CnnPolicy): the games benchmark
+# (kinds/games.py) feeds the objects to `fqi.SetEncoder` instead.
+ATARI_DQN = {
+    "learning_rate": 1e-4, "buffer_size": 100_000, "learning_starts": 100_000,
+    "batch_size": 32, "target_update_interval": 1000, "train_freq": 4, "gradient_steps": 1,
+    "exploration_fraction": 0.1, "exploration_final_eps": 0.01,
+}
+ATARI_PPO = {"n_envs": 8, "n_steps": 128, "n_epochs": 4, "batch_size": 256,
+             "learning_rate": 2.5e-4, "clip_range": 0.1, "vf_coef": 0.5, "ent_coef": 0.01}
+# highway-env's own stable-baselines3 scripts for highway-fast-v0 (scripts/sb3_highway_dqn.py
+# and sb3_highway_ppo.py, 20,000 steps each; PPO on 6 envs)
+HIGHWAY_DQN = {
+    "learning_rate": 5e-4, "buffer_size": 15_000, "learning_starts": 200, "batch_size": 32,
+    "gamma": 0.8, "train_freq": 1, "gradient_steps": 1, "target_update_interval": 50,
+    "policy_kwargs": {"net_arch": [256, 256]},
+}
+HIGHWAY_PPO = {"n_envs": 6, "n_steps": 128, "batch_size": 64, "n_epochs": 10,
+               "learning_rate": 5e-4, "gamma": 0.8,
+               "policy_kwargs": {"net_arch": {"pi": [256, 256], "vf": [256, 256]}}}

@@ -38,8 +38,10 @@ class Budget:
     max_trees, max_tests : int or None
         Caps on the forests' M and K (None: the thesis's values).
     control_scale : float, default=1.0
-        Multiplies the environment steps of the runs on gymnasium's tasks (``control``
-        units), whose settings give them at full size.
+        Multiplies the environment steps of the runs on gymnasium's tasks and on the real
+        games (``control`` and ``games`` units), whose settings give them at full size.
+    game_frames : int, default=None
+        Caps the frames of an Atari episode of the ``games`` units (None: ALE's 108,000).
     overrides : dict of str to dict
         Experiment name -> parameters replacing its settings' at this budget (applied to
         every setting of the experiment alike, so its comparison stays fair).
@@ -57,6 +59,7 @@ class Budget:
     max_trees: int = None
     max_tests: int = None
     control_scale: float = 1.0
+    game_frames: int = None
     overrides: dict = field(default_factory=dict)
 
     @property
@@ -84,5 +87,5 @@ BUDGETS = {
     # for the tests: every experiment end to end in seconds
     "tiny": Budget("tiny", seeds=1, iterations=2, samples=200, eval_steps=50,
                    rmse_samples=200, rmse_folds=2, dqn_steps=100, attention_iterations=1,
-                   max_trees=2, max_tests=10, control_scale=0.01),
+                   max_trees=2, max_tests=10, control_scale=0.01, game_frames=800),
 }

@@ -9,7 +9,8 @@ beside ours.
 """
 from dataclasses import dataclass, field, replace
 
-from ..zoo_hyperparams import SMALL_TASK_DQN, ZOO_DQN, ZOO_PPO, ZOO_STEPS, without_gamma
+from ..zoo_hyperparams import (ATARI_DQN, ATARI_PPO, HIGHWAY_DQN, HIGHWAY_PPO, SMALL_TASK_DQN,
+                               ZOO_DQN, ZOO_PPO, ZOO_STEPS, without_gamma)
 from .budgets import BUDGETS
 from .findings import (AtLeast, Falls, Faster, HighestPeak, MoreStable, NearRandom, Ranking,
                        Sign, Similar)
@@ -582,6 +583,48 @@ EXPERIMENTS += (
         settings={label: {"fqi": fqi} for label, fqi in _FQI_VARIANTS.items()},
         notes="30 Extra-Trees (n_min 10); the evidence for `fqi.FQI`'s defaults."),
 )
+
+# Real games seen as objects (on demand: ``--only games_pong``): box FQI against DQN and PPO
+# reading the same objects, the random policy and a scripted one, at equal environment
+# steps. Atari: rl-zoo3's Atari settings, 500,000 agent steps (2 million frames); highway:
+# highway-env's own scripts' settings and budget, 20,000 steps.
+_ATARI_FQI = {"forest": {"n_estimators": 30, "n_jobs": 1},
+              "fqi": {"samples_per_iteration": 25_000, "resample_every": 2}}
+_HIGHWAY_FQI = {"forest": {"n_estimators": 30, "n_jobs": 1},
+                "fqi": {"gamma": 0.8, "samples_per_iteration": 1_000}}
+_GAMES = {  # name -> (env_id, env_kwargs, steps, eval_every, max_objects, FQI, DQN, PPO, source)
+    "games_pong": ("AtariObjects-v0", {"game": "Pong"}, 500_000, 100_000, 8, _ATARI_FQI,
+                   ATARI_DQN, ATARI_PPO, "rl-zoo3"),
+    "games_freeway": ("AtariObjects-v0", {"game": "Freeway"}, 500_000, 100_000, 16,
+                      _ATARI_FQI, ATARI_DQN, ATARI_PPO, "rl-zoo3"),
+    "games_boxing": ("AtariObjects-v0", {"game": "Boxing"}, 500_000, 100_000, 8, _ATARI_FQI,
+                     ATARI_DQN, ATARI_PPO, "rl-zoo3"),
+    "games_highway": ("highway-fast-v0", {}, 20_000, 2_000, 32, _HIGHWAY_FQI, HIGHWAY_DQN,
+                      HIGHWAY_PPO, "highway-env"),
+}
+
+
+def _games(name, env_id, env_kwargs, steps, eval_every, max_objects, fqi, dqn, ppo, source):
+    game = env_kwargs.get("game", env_id)
+    return Experiment(
+        name, "extra", f"{game}: box FQI against DQN and PPO on the same objects", "games",
+        env_id=env_id, on_demand=True, seeds=3,
+        defaults={"env_kwargs": env_kwargs, "eval_every": eval_every,
+                  "max_objects": max_objects},
+        settings={"box FQI": {"learner": "fqi", "steps": steps, **fqi},
+                  f"DQN ({source})": {"learner": "DQN", "steps": steps, "hyperparams": dqn},
+                  f"PPO ({source})": {"learner": "PPO", "steps": steps, "hyperparams": ppo},
+                  "random policy": {"learner": "random"},
+                  "scripted policy": {"learner": "scripted"}},
+        notes=f"Mean return of 5 held-out episodes every {eval_every:,} of {steps:,} "
+              f"environment steps. The objects: `envs.AtariObjects` (rows [x, y, w, h, dx, "
+              f"dy, type] relative to the player) or `envs.HighwayObjects`; FQI reads them "
+              f"with 30 box Extra-Trees (boxtrees' defaults), DQN and PPO padded to "
+              f"{max_objects} rows through `fqi.SetEncoder`, with {source}'s settings; one "
+              f"core per run.")
+
+
+EXPERIMENTS += tuple(_games(name, *spec) for name, spec in _GAMES.items())
 
 REGISTRY = {experiment.name: experiment for experiment in EXPERIMENTS}
 

@@ -19,7 +19,8 @@ def test_registry_covers_every_thesis_figure_once():
     assert {e.name for e in EXPERIMENTS if e.figure == "extra" and not e.explains} == {
         "keep_data", "dqn", "attention", "ceiling", "ceiling_sword", "baselines",
         "search_dqn_grid", "search_dqn_objects", "search_ppo_objects", "control_cartpole",
-        "control_acrobot", "control_mountaincar", "control_lunarlander", "fqi_defaults"}
+        "control_acrobot", "control_mountaincar", "control_lunarlander", "fqi_defaults",
+        "games_pong", "games_freeway", "games_boxing", "games_highway"}
     ablations = [e for e in EXPERIMENTS if e.explains]
     assert {name for e in ablations for name in e.explains} == {
         "rmse_K", "rmse_nmin", "rmse_TW", "rmse_grid", "fqi_grid", "representations",
@@ -29,7 +30,8 @@ def test_registry_covers_every_thesis_figure_once():
         assert all(REGISTRY[name].figure != "extra" for name in ablation.explains)
     assert {e.name for e in EXPERIMENTS if e.on_demand} == {
         "search_dqn_grid", "search_dqn_objects", "search_ppo_objects", "control_cartpole",
-        "control_acrobot", "control_mountaincar", "control_lunarlander", "fqi_defaults"}
+        "control_acrobot", "control_mountaincar", "control_lunarlander", "fqi_defaults",
+        "games_pong", "games_freeway", "games_boxing", "games_highway"}
     assert len(REGISTRY) == len(EXPERIMENTS)
 
 
@@ -49,8 +51,9 @@ def test_every_setting_resolves_and_every_rule_names_real_settings(experiment):
     for label in experiment.settings:
         owner, owner_label = resolve(experiment, label)
         params = owner.params(owner_label)
-        # the thesis's game, but for gymnasium's own tasks
-        assert params["env_id"].startswith("ObjectWorld") == (params["kind"] != "control")
+        # the thesis's game, but for gymnasium's own tasks and the real games
+        assert params["env_id"].startswith("ObjectWorld") == (params["kind"] not in (
+            "control", "games"))
         if params["kind"] == "sb3":
             assert "gamma" in params["hyperparams"]      # searched, never SB3's default
     for rule in experiment.findings:

@@ -13,7 +13,7 @@ from ._base import GameSettings, UnitKind
 from ._game import make_env, reference_seeds
 from .dqn import sb3_cost, sb3_steps
 
-__all__ = ["TunedBaseline"]
+__all__ = ["TunedBaseline", "with_set_encoder"]
 
 
 @dataclass(frozen=True)
@@ -55,12 +55,18 @@ class TunedBaselineSettings(GameSettings):
         """The hyperparameters, with the set encoder for object observations."""
         if self.observation == "grid":
             return self.hyperparams
-        from fqi import SetEncoder  # imports torch: only here
+        return with_set_encoder(self.hyperparams, self.attention)
 
-        policy_kwargs = {**self.hyperparams.get("policy_kwargs", {}),
-                         "features_extractor_class": SetEncoder,
-                         "features_extractor_kwargs": {"attention": self.attention}}
-        return {**self.hyperparams, "policy_kwargs": policy_kwargs}
+
+def with_set_encoder(hyperparams, attention=False):
+    """stable-baselines3 `hyperparams` whose policy reads padded objects through
+    `fqi.SetEncoder` (with `attention`)."""
+    from fqi import SetEncoder  # imports torch: only here
+
+    policy_kwargs = {**hyperparams.get("policy_kwargs", {}),
+                     "features_extractor_class": SetEncoder,
+                     "features_extractor_kwargs": {"attention": attention}}
+    return {**hyperparams, "policy_kwargs": policy_kwargs}
 
 
 class TunedBaseline(UnitKind):
