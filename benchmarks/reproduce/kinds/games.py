@@ -96,12 +96,12 @@ class _ScriptedPolicy:
 class GamesSettings:
     """``env_id``: ``"AtariObjects-v0"`` (`envs.AtariObjects`) or a highway-env id such as
     "highway-fast-v0" (wrapped in `envs.HighwayObjects`), made with ``env_kwargs`` (the
-    Atari game's name and arguments, or highway-env's ``config``); ``learner`` ("fqi", "DQN", "PPO", "random" or
-    "scripted") and ``steps`` (environment steps at full size, for the learners); for FQI
-    ``forest`` (`boxtrees.BoxExtraTreesRegressor` arguments) and ``fqi`` (`fqi.FQI`
-    arguments other than its defaults); for SB3 ``hyperparams`` (rl-zoo3's form,
-    `training.train_sb3`) and ``max_objects`` (the padded rows); the evaluation:
-    ``eval_episodes`` held-out episodes every ``eval_every`` steps."""
+    Atari game's name and arguments, or highway-env's ``config``); ``learner`` ("fqi",
+    "DQN", "PPO", "random" or "scripted") and ``steps`` (environment steps at full size,
+    for the learners); for FQI ``forest`` (`boxtrees.BoxExtraTreesRegressor` arguments)
+    and ``fqi`` (`fqi.FQI` arguments other than its defaults); for SB3 ``hyperparams``
+    (rl-zoo3's form, `training.train_sb3`) and ``max_objects`` (the padded rows); the
+    evaluation: ``eval_episodes`` held-out episodes every ``eval_every`` steps."""
 
     env_id: str
     learner: str = None
@@ -154,30 +154,45 @@ class Games(Control):
     budget_fields = ("control_scale", "game_frames")
 
     def run(self, unit, checkpoint=None):
-        from ...training import EvalCallback, WrappedPolicy, timed_learn, train_sb3
-
         settings, budget = unit.settings, unit.budget
         env = settings.make_env(budget)
         evaluation = gym.make_vec(env.spec, settings.eval_episodes, vectorization_mode="sync")
-        if settings.learner in ("random", "scripted"):
-            policy = (RandomPolicy(env, seed=unit.seed) if settings.learner == "random"
-                      else _ScriptedPolicy(_SCRIPTS[settings.game](env.unwrapped)))
-            start = time.perf_counter()
-            score = float(evaluate(policy, evaluation, n_episodes=settings.eval_episodes).mean)
-            return self._result(settings, score, [[0, score]], 0, 0.0, 0.0,
-                                time.perf_counter() - start)
+        try:
+            if settings.learner in ("random", "scripted"):
+                return self._play(unit, env, evaluation)
+            return self._learn(unit, env, evaluation)
+        finally:
+            evaluation.close()
+            env.close()
+
+    def _play(self, unit, env, evaluation):
+        """A fixed policy's result: its score, once."""
+        settings = unit.settings
+        policy = (RandomPolicy(env, seed=unit.seed) if settings.learner == "random"
+                  else _ScriptedPolicy(_SCRIPTS[settings.game](env.unwrapped)))
+        start = time.perf_counter()
+        score = float(evaluate(policy, evaluation, n_episodes=settings.eval_episodes).mean)
+        return self._result(settings, score, [[0, score]], 0, 0.0, 0.0,
+                            time.perf_counter() - start)
+
+    def _learn(self, unit, env, evaluation):
+        """A learner's result: its score every ``eval_every`` steps and at the end."""
+        from ...training import EvalCallback, WrappedPolicy, timed_learn, train_sb3
+
+        settings, budget = unit.settings, unit.budget
         steps = max(1, round(settings.steps * budget.control_scale))
+        padded = envs.PaddedObjects(env, settings.max_objects)
         curve = EvalCallback(evaluation, max(1, round(settings.eval_every
                                                       * budget.control_scale)),
-                             n_episodes=settings.eval_episodes)
+                             n_episodes=settings.eval_episodes,
+                             policy=(None if settings.learner == "fqi"
+                                     else lambda model: WrappedPolicy(model, padded)))
         if settings.learner == "fqi":
             agent = FQI(BoxExtraTreesRegressor(**settings.forest), env, eval_episodes=0,
                         seed=unit.seed, **settings.fqi)
             seconds, cpu_seconds = timed_learn(agent, curve, total_timesteps=steps)
             done = agent.num_timesteps
         else:
-            padded = envs.PaddedObjects(env, settings.max_objects)
-            curve.policy = lambda model: WrappedPolicy(model, padded)
             model, seconds, cpu_seconds = train_sb3(
                 settings.learner,
                 lambda: envs.PaddedObjects(settings.make_env(budget), settings.max_objects),
