@@ -573,6 +573,12 @@ _FQI_VARIANTS = {
     "epsilon to 0.2": {"exploration_final_eps": 0.2},
     "gamma 0.98": {"gamma": 0.98},
     "new data only (thesis)": {"keep_data": False, "resample_every": 1},
+    "epsilon to 0.2, rounds of 1,000 steps": {"exploration_final_eps": 0.2,
+                                              "samples_per_iteration": 1000,
+                                              "resample_every": 2},
+    "epsilon to 0.2, 10 backups per round": {"exploration_final_eps": 0.2, "resample_every": 10},
+    "epsilon 0.2 from the second round": {"exploration_fraction": 0.0,
+                                          "exploration_final_eps": 0.2},
 }
 EXPERIMENTS += (
     *(_control(env_id) for env_id in _CONTROL),
