@@ -19,7 +19,6 @@ from ._optional import missing_extra
 
 __all__ = ["AtariObjects", "atari_games"]
 
-ATTRIBUTE_NAMES = ("x", "y", "w", "h", "dx", "dy")
 # Bounds of the attributes: the screen is 160 x 210 pixels and the RAM places a few objects
 # just off it, so no position, size or motion read so far came near them (values beyond
 # are clipped).
@@ -189,6 +188,8 @@ class AtariObjects(gym.Env):
     ----------
     game : str
         The game's name.
+    attribute_names : tuple of str
+        ``("x", "y", "w", "h", "dx", "dy")``, the names of the columns before the type.
     type_names : tuple of str
         OCAtari's categories of the game (the object classes it defines, HUD's included),
         sorted; type id ``i`` is ``type_names[i]``, the same in every episode and every env
@@ -230,6 +231,7 @@ class AtariObjects(gym.Env):
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 15}
+    attribute_names = ("x", "y", "w", "h", "dx", "dy")
 
     def __init__(self, game, *, mode="ram", hud=False, player="auto", frameskip=None,
                  repeat_action_probability=None, full_action_space=None,
@@ -250,7 +252,7 @@ class AtariObjects(gym.Env):
             env_id, mode=mode, hud=self.hud, obs_mode="ori", create_buffer_stacks=[],
             obs_type="ram", **{key: value for key, value in ale.items() if value is not None})
         self.action_space = self._ocatari.action_space
-        self.action_names = tuple(self._ocatari.unwrapped.get_action_meanings())
+        self.action_names = tuple(self._ocatari.get_action_meanings())
         low = np.array([-_BOUND, -_BOUND, 0, 0, -_BOUND, -_BOUND, 0], dtype=np.float32)
         high = np.array([_BOUND] * 6 + [self.n_types - 1], dtype=np.float32)
         self.observation_space = spaces.Sequence(spaces.Box(low, high, dtype=np.float32),

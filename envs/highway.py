@@ -14,7 +14,6 @@ from ._optional import missing_extra
 __all__ = ["HighwayObjects"]
 
 TYPE_NAMES = ("ego", "vehicle", "obstacle", "landmark")
-ATTRIBUTE_NAMES = ("x", "y", "vx", "vy", "cos_h", "sin_h")
 
 
 @functools.cache
@@ -70,6 +69,9 @@ class HighwayObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
 
     Attributes
     ----------
+    attribute_names : tuple of str
+        ``("x", "y", "vx", "vy", "cos_h", "sin_h")``, the names of the columns before the
+        type.
     type_names : tuple of str
         ``("ego", "vehicle", "obstacle", "landmark")``.
     n_types : int
@@ -92,6 +94,7 @@ class HighwayObjects(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     (7, array([0., 0.], dtype=float32), np.float32(0.0))
     """
 
+    attribute_names = ("x", "y", "vx", "vy", "cos_h", "sin_h")
     type_names = TYPE_NAMES
 
     def __init__(self, env, max_distance=None):

@@ -262,6 +262,7 @@ def test_highway_rows_are_relative_to_the_ego_vehicle_on_a_hand_checked_frame():
 
 
 @needs_highway
+@pytest.mark.filterwarnings("ignore:.*is different from the unwrapped version")  # a wrapper
 def test_highway_passes_gymnasiums_env_checker_and_rejects_other_envs():
     check_env(envs.HighwayObjects(gym.make(HIGHWAY)), skip_render_check=True)
     with pytest.raises(TypeError, match="needs an env of highway-env"):
