@@ -73,10 +73,10 @@ def test_an_interrupted_fqi_run_resumes_from_its_last_iteration_to_the_same_resu
     run([uninterrupted], progress=False)
     iterate = FQI._iterate
 
-    def stop_at_the_third(agent):
+    def stop_at_the_third(agent, n_samples):
         if agent.iteration == 2:
             raise KeyboardInterrupt
-        return iterate(agent)
+        return iterate(agent, n_samples)
 
     monkeypatch.setattr(FQI, "_iterate", stop_at_the_third)
     with pytest.raises(KeyboardInterrupt):
@@ -85,8 +85,8 @@ def test_an_interrupted_fqi_run_resumes_from_its_last_iteration_to_the_same_resu
     assert checkpoint.load()["agent"].iteration == 2 and attempts(resumed.path) == 0
     resumed_iterations = []
     monkeypatch.setattr(FQI, "_iterate",
-                        lambda agent: resumed_iterations.append(agent.iteration)
-                        or iterate(agent))
+                        lambda agent, n_samples: resumed_iterations.append(agent.iteration)
+                        or iterate(agent, n_samples))
     run([resumed], progress=False)
     assert resumed_iterations == [2]  # only the missing iteration ran
     assert not checkpoint.path.exists()  # gone with the finished result

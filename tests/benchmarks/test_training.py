@@ -26,7 +26,7 @@ def test_an_sb3_model_is_scored_during_training_and_after_its_last_update(tmp_pa
 
 def test_fqi_is_scored_by_the_same_callback_after_its_iterations():
     agent = FQI(ExtraTreesRegressor(n_estimators=5, random_state=0), "CartPole-v1",
-                samples_per_iteration=100, eval_episodes=0, seed=0)
+                samples_per_iteration=100, resample_every=1, eval_episodes=0, seed=0)
     curve = EvalCallback("CartPole-v1", 150, n_episodes=2, score="total", scale=0.5)
     seconds, _ = timed_learn(agent, curve, n_iterations=4)
     steps = [steps for steps, _ in curve.evaluations]  # collections overshoot a little
