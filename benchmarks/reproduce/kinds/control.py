@@ -13,7 +13,7 @@ from .. import plots
 from ..cache import ListOf
 from ._base import UnitKind, fmt
 
-__all__ = ["Control", "REGRESSORS"]
+__all__ = ["Control", "REGRESSORS", "training_minutes"]
 
 # The Extra-Trees of the FQI agents: 30 trees, nodes of fewer than 10 samples are leaves,
 # one job (so that every learner gets one core).
@@ -117,10 +117,15 @@ class Control(UnitKind):
             results = [r["result"] for r in runs[label]]
             solved = [r["steps_to_threshold"] for r in results
                       if r.get("steps_to_threshold") is not None]
-            minutes = np.mean([r["train_seconds"] for r in results]) / 60
-            cpu = np.mean([r["train_cpu_seconds"] for r in results]) / 60
             lines.append(f"| {label} | {s.n_runs} | {s.score:,.1f} +- {s.score_sd:,.1f} | "
                          f"{len(solved)}/{s.n_runs} | "
                          f"{fmt(float(np.median(solved))) if solved else '-'} | "
-                         f"{minutes:.1f} ({cpu:.1f}) |")
+                         f"{training_minutes(results)} |")
         return lines
+
+
+def training_minutes(results):
+    """Mean training minutes per run, wall and CPU, as ``"wall (CPU)"`` for a table."""
+    wall, cpu = (np.mean([r[key] for r in results]) / 60
+                 for key in ("train_seconds", "train_cpu_seconds"))
+    return f"{wall:.1f} ({cpu:.1f})"

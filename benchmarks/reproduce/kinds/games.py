@@ -14,7 +14,7 @@ from boxtrees import BoxExtraTreesRegressor
 from fqi import FQI, RandomPolicy, evaluate
 
 from ._base import fmt
-from .control import Control
+from .control import Control, training_minutes
 from .sb3 import with_set_encoder
 
 __all__ = ["Games", "HUMAN_SCORES"]
@@ -233,10 +233,9 @@ class Games(Control):
             results = [r["result"] for r in runs[label]]
             normalised = [r["human_normalised"] for r in results]
             normalised = None if None in normalised else float(np.mean(normalised))
-            minutes = np.mean([r["train_seconds"] for r in results]) / 60
-            cpu = np.mean([r["train_cpu_seconds"] for r in results]) / 60
+            trained = any(r["train_seconds"] for r in results)  # not a fixed policy
             lines.append(f"| {label} | {s.n_runs} | {s.score:,.1f} +- {s.score_sd:,.1f} | "
                          f"{fmt(normalised, 2)} | "
-                         f"{fmt(results[0]['total_timesteps']) if minutes else '-'} | "
-                         f"{minutes:.1f} ({cpu:.1f}) |")
+                         f"{fmt(results[0]['total_timesteps']) if trained else '-'} | "
+                         f"{training_minutes(results)} |")
         return lines
