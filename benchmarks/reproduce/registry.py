@@ -586,8 +586,10 @@ EXPERIMENTS += (
         "fqi_defaults", "extra", "CartPole-v1: FQI's defaults, one change at a time",
         "control", env_id="CartPole-v1", on_demand=True, seeds=3,
         defaults={"learner": "fqi", "steps": 50_000, "threshold": 475.0},
-        settings={label: {"fqi": fqi} for label, fqi in _FQI_VARIANTS.items()},
-        notes="30 Extra-Trees (n_min 10); the evidence for `fqi.FQI`'s defaults."),
+        settings={**{label: {"fqi": fqi} for label, fqi in _FQI_VARIANTS.items()},
+                  "trees grown out (n_min 2)": {"regressor": "extra-trees, grown out"}},
+        notes="30 Extra-Trees (n_min 10, but where grown out); the evidence for `fqi.FQI`'s "
+              "defaults."),
 )
 
 # Real games seen as objects (on demand: ``--only games_pong``): box FQI against DQN and PPO

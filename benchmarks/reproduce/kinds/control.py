@@ -15,11 +15,12 @@ from ._base import UnitKind, fmt
 
 __all__ = ["Control", "REGRESSORS", "training_minutes"]
 
-# The Extra-Trees of the FQI agents: 30 trees, nodes of fewer than 10 samples are leaves,
-# one job (so that every learner gets one core).
+# The Extra-Trees of the FQI agents: 30 trees, nodes of fewer than 10 samples are leaves (or
+# scikit-learn's default of 2: grown out), one job (so that every learner gets one core).
 REGRESSORS = {
     "extra-trees": lambda: ExtraTreesRegressor(n_estimators=30, min_samples_split=10,
                                                n_jobs=1),
+    "extra-trees, grown out": lambda: ExtraTreesRegressor(n_estimators=30, n_jobs=1),
     "box-classic": lambda: make_box_forest(test_type="classic", n_estimators=30, n_tests=10,
                                            min_samples_split=10, n_jobs=1),
 }
