@@ -124,7 +124,8 @@ def versus_steps(experiment, stats, curves, budget, ylabel="reward per 20,000 gr
     if threshold is not None:
         ax.axhline(threshold, color="black", ls=":", lw=1.0)
         ax.annotate(f"solved ({threshold:,.0f})", (0, threshold), xytext=(2, 3),
-                    textcoords="offset points", fontsize=7)
+                    xycoords=("axes fraction", "data"), textcoords="offset points",
+                    fontsize=7)
     ax.set_xlabel("environment steps")
     ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
     ax.yaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
