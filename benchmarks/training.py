@@ -93,8 +93,11 @@ class EvalCallback(BaseCallback):
         self._due, self._end = eval_freq, None
 
     def _on_training_start(self):
-        # SB3's learn has its total here; FQI's calls come after whole iterations
-        self._end = self.locals.get("total_timesteps")
+        # the step count at which training ends: SB3 keeps it; FQI's learn has the steps of
+        # the call (None with n_iterations, whose calls come after whole iterations)
+        total = self.locals.get("total_timesteps")
+        self._end = getattr(self.model, "_total_timesteps", None) or (
+            None if total is None else self.model.num_timesteps + total)
 
     def _on_step(self):
         if self.num_timesteps >= self._due and (self._end is None
@@ -131,11 +134,17 @@ def timed_learn(model, callback=None, **learn_kwargs):
     """
     evaluations = [c for c in (callback if isinstance(callback, list) else [callback])
                    if isinstance(c, EvalCallback)]
+
+    def evaluating():
+        return (sum(c.eval_seconds for c in evaluations),
+                sum(c.eval_cpu_seconds for c in evaluations))
+
+    before = evaluating()
     start, cpu_start = time.perf_counter(), time.process_time()
     model.learn(callback=callback, **learn_kwargs)
     seconds, cpu_seconds = time.perf_counter() - start, time.process_time() - cpu_start
-    return (seconds - sum(c.eval_seconds for c in evaluations),
-            cpu_seconds - sum(c.eval_cpu_seconds for c in evaluations))
+    after = evaluating()  # of this call only: a callback may have scored earlier calls
+    return seconds - (after[0] - before[0]), cpu_seconds - (after[1] - before[1])
 
 
 def train_sb3(algo, make_env, total_timesteps, hyperparams, *, seed=None, callback=None,

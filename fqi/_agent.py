@@ -270,8 +270,9 @@ class FQI:
         Builds the training vector env and the evaluation one (from `eval_env`, else from
         the constructor's `eval_env`, else from `env`), then tries the env (a reset and a
         step) and the regressor (fitted on those observations). Collection starts new
-        episodes. The previous envs are left as they are (as stable-baselines3 does); a call
-        that fails closes the vector envs it built.
+        episodes, on an empty data set (the transitions of the previous env are dropped).
+        The previous envs are left as they are (as stable-baselines3 does); a call that fails
+        closes the vector envs it built.
 
         Parameters
         ----------
@@ -387,6 +388,9 @@ class FQI:
             its number of transitions; `num_timesteps` counts every env step, so it grows by
             exactly `total_timesteps` with one env, and by up to ``n_envs - 1`` more with
             several (they step together: the last step of a round may go past its count).
+            Each call runs the exploration schedule over its own steps, as
+            stable-baselines3's ``learn`` does by default (``reset_num_timesteps=True``):
+            a call continuing training starts again from `exploration_initial_eps`.
         callback : callable, BaseCallback or list, default=None
             Called after every iteration. A stable-baselines3 ``BaseCallback`` or
             ``CallbackList`` is taken as it is, with the agent as its ``model``:
@@ -465,6 +469,10 @@ class FQI:
         (3, 0)
         """
         n_iterations = _check_int("n_iterations", n_iterations, 1)
+        if self._eval_seeds and self._eval_env is None:
+            raise ValueError("this agent has no env to evaluate on (it was loaded without "
+                             "one): pass env to FQI.load, call set_env(env), or load it with "
+                             "eval_episodes=0")
         self._data = _dataset_transitions(dataset, self._observations, self.observation_space,
                                           self.action_space)
         return self._train(callback, progress_bar, None, n_iterations, collect=False)

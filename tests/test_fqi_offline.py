@@ -115,3 +115,15 @@ def test_a_bad_dataset_is_named(change, error, match):
 def test_something_else_is_no_dataset():
     with pytest.raises(TypeError, match="dataset must be a mapping"):
         cartpole().learn_offline([1, 2, 3], n_iterations=1)
+
+
+def test_an_agent_loaded_without_an_env_needs_one_to_evaluate(tmp_path):
+    data = random_transitions("CartPole-v1", 200)
+    agent = FQI(ExtraTreesRegressor(n_estimators=3), lambda: gym.make("CartPole-v1"),
+                eval_episodes=2, seed=0).learn_offline(data, n_iterations=1)
+    agent.save(tmp_path / "agent.joblib")
+    loaded = FQI.load(tmp_path / "agent.joblib")  # made from a factory: saved without it
+    with pytest.raises(ValueError, match="no env to evaluate on"):
+        loaded.learn_offline(data, n_iterations=1)
+    assert len(loaded.history) == 1  # unchanged
+    FQI.load(tmp_path / "agent.joblib", eval_episodes=0).learn_offline(data, n_iterations=1)

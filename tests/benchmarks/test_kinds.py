@@ -128,6 +128,10 @@ def test_reference_policies_score_on_the_reference_worlds_as_learners_do():
      "observation 'objects' needs max_objects"),
     ("policy", {"env_id": "ObjectWorld-v0", "policy": "human"}, "policy must be one of"),
     ("dqn", {"n_bins": 4}, "missing 1 required positional argument: 'env_id'"),
+    ("control", {"env_id": "CartPole-v1", "learner": "fqi", "steps": 10,
+                 "fqi": {"epsilon": 0.1}}, "fqi takes no argument epsilon"),
+    ("control", {"env_id": "CartPole-v1", "learner": "fqi", "steps": 10,
+                 "fqi": {"seed": 1}}, "fqi takes no argument seed"),
 ])
 def test_a_settings_mistake_is_named(kind, params, match):
     with pytest.raises(ValueError, match=match):

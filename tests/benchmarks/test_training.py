@@ -52,3 +52,16 @@ def test_a_model_trained_on_wrapped_observations_plays_from_the_envs_own():
 def test_bad_evaluation_settings(kwargs, match):
     with pytest.raises(ValueError, match=match):
         EvalCallback("CartPole-v1", **{"eval_freq": 10, **kwargs})
+
+
+def test_a_continued_fqi_agent_is_scored_during_its_second_call_too():
+    agent = FQI(ExtraTreesRegressor(n_estimators=3, random_state=0), "CartPole-v1",
+                samples_per_iteration=200, resample_every=1, n_envs=1, eval_episodes=0,
+                seed=0).learn(total_timesteps=600)
+    curve = EvalCallback("CartPole-v1", 200, n_episodes=1)
+    timed_learn(agent, curve, total_timesteps=600)
+    # the first multiple of 200 comes at once, then one per round; the end once
+    assert [steps for steps, _ in curve.evaluations] == [800, 1000, 1200]
+    before = curve.eval_seconds
+    seconds, _ = timed_learn(agent, curve, total_timesteps=200)  # the same callback again
+    assert curve.eval_seconds > before and seconds > 0  # only this call's evaluations out

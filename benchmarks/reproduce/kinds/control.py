@@ -1,6 +1,7 @@
 """``control``: a learner on a gymnasium task (classic control and any other registered id):
 FQI with the library's defaults, or a stable-baselines3 algorithm with tuned settings,
 scored on held-out episodes every few thousand steps."""
+import inspect
 from dataclasses import dataclass, field
 
 import gymnasium as gym
@@ -25,6 +26,9 @@ REGRESSORS = {
                                            min_samples_split=10, n_jobs=1),
 }
 _SECONDS_PER_STEP = 2.5e-3  # FQI's defaults on CartPole-v1, one core (measured)
+# FQI's arguments a setting may give (the kind sets the others)
+_FQI_SETTABLE = frozenset(inspect.signature(FQI).parameters) - {
+    "regressor", "env", "eval_episodes", "seed"}
 
 
 @dataclass(frozen=True)
@@ -53,6 +57,11 @@ class ControlSettings:
                              f"{self.regressor!r}")
         if not isinstance(self.steps, int) or self.steps < 1:
             raise ValueError(f"steps must be a whole number >= 1, got {self.steps!r}")
+        unknown = sorted(set(self.fqi) - _FQI_SETTABLE)
+        if unknown:
+            raise ValueError(f"fqi takes no argument {', '.join(unknown)} here (the kind sets "
+                             f"regressor, env, eval_episodes and seed; FQI's others: "
+                             f"{', '.join(sorted(_FQI_SETTABLE))})")
 
 
 class Control(UnitKind):
@@ -68,20 +77,24 @@ class Control(UnitKind):
 
         settings, scale = unit.settings, unit.budget.control_scale
         steps = max(1, round(settings.steps * scale))
-        curve = EvalCallback(gym.make_vec(settings.env_id, settings.eval_episodes,
-                                          vectorization_mode="sync"),
-                             max(1, round(settings.eval_every * scale)),
+        evaluation = gym.make_vec(settings.env_id, settings.eval_episodes,
+                                  vectorization_mode="sync")
+        curve = EvalCallback(evaluation, max(1, round(settings.eval_every * scale)),
                              n_episodes=settings.eval_episodes)
-        if settings.learner == "fqi":
-            agent = FQI(REGRESSORS[settings.regressor](), settings.env_id, eval_episodes=0,
-                        seed=unit.seed, **settings.fqi)
-            seconds, cpu_seconds = timed_learn(agent, curve, total_timesteps=steps)
-            done = agent.num_timesteps
-        else:
-            model, seconds, cpu_seconds = train_sb3(
-                settings.learner, lambda: gym.make(settings.env_id), steps,
-                settings.hyperparams, seed=unit.seed, callback=curve)
-            done = model.num_timesteps
+        try:
+            if settings.learner == "fqi":
+                agent = FQI(REGRESSORS[settings.regressor](), settings.env_id,
+                            eval_episodes=0, seed=unit.seed, **settings.fqi)
+                seconds, cpu_seconds = timed_learn(agent, curve, total_timesteps=steps)
+                done = agent.num_timesteps
+                agent.get_env().close()
+            else:
+                model, seconds, cpu_seconds = train_sb3(
+                    settings.learner, lambda: gym.make(settings.env_id), steps,
+                    settings.hyperparams, seed=unit.seed, callback=curve)
+                done = model.num_timesteps
+        finally:
+            evaluation.close()
         threshold = settings.threshold
         solved = next((s for s, mean in curve.evaluations
                        if threshold is not None and mean >= threshold), None)

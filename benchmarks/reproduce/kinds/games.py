@@ -192,6 +192,7 @@ class Games(Control):
                         seed=unit.seed, **settings.fqi)
             seconds, cpu_seconds = timed_learn(agent, curve, total_timesteps=steps)
             done = agent.num_timesteps
+            agent.get_env().close()
         else:
             model, seconds, cpu_seconds = train_sb3(
                 settings.learner,
