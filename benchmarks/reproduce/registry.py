@@ -546,6 +546,8 @@ def _control(env_id):
         env_id=env_id, on_demand=True, defaults={"threshold": _CONTROL[env_id]},
         settings={
             "FQI, Extra-Trees": {"learner": "fqi", "steps": steps},
+            "FQI, Extra-Trees grown out": {"learner": "fqi", "steps": steps,
+                                           "regressor": "extra-trees, grown out"},
             "FQI, boxtrees classic": {"learner": "fqi", "regressor": "box-classic",
                                       "steps": steps},
             "DQN (rl-zoo3)": {"learner": "DQN", "hyperparams": ZOO_DQN[env_id],
@@ -553,7 +555,8 @@ def _control(env_id):
             "PPO (rl-zoo3)": {"learner": "PPO", "hyperparams": ZOO_PPO[env_id],
                               "steps": ZOO_STEPS["PPO"][env_id]}},
         notes=f"Mean return on 20 held-out episodes every 5,000 steps. FQI: `fqi.FQI`'s "
-              f"defaults with 30 Extra-Trees (scikit-learn's, or boxtrees' classic splits) "
+              f"defaults with 30 Extra-Trees (scikit-learn's with n_min 10 or grown out, or "
+              f"boxtrees' classic splits) "
               f"for rl-zoo3's DQN budget ({steps:,} steps); DQN and PPO: rl-zoo3's tuned "
               f"settings and budgets; one core per run.")
 
