@@ -16,8 +16,8 @@ from sklearn.exceptions import NotFittedError
 from tqdm.auto import tqdm
 
 from ._callbacks import _as_callback
-from ._checks import (_check_bool, _check_int, _check_n_jobs, _check_real, _check_seed,
-                      _check_verbose)
+from ._checks import (_check_bool, _check_choice, _check_int, _check_n_jobs, _check_real,
+                      _check_seed, _check_verbose)
 from ._collect import _Collector, _Transitions
 from ._datasets import _dataset_transitions
 from ._envs import (_check_env, _close_built, _evaluation_vector, _make_vector, _n_actions,
@@ -32,6 +32,8 @@ from ._typing import Callback, Dataset, EnvLike, Logger, Observation, Regressor
 __all__ = ["FQI"]
 
 _DEFAULT_ENVS = 16
+_TIE_BREAKS = ("random", "first")
+_TIE_TOLERANCE = 1e-6  # relative: Q-values closer than this to the best tie with it
 # What `save` leaves out (SB3 saves its __dict__ minus such a list): the envs, which hold
 # simulators, the transitions, the threads and the logs.
 _UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_data", "_csv_log",
@@ -113,6 +115,14 @@ class FQI:
         Probability of a uniform random action while collecting, at the start and at the end
         of the schedule (the thesis: 0.2 throughout). The first round plays uniformly at
         random whatever they are: there is no Q-function yet.
+    tie_break : {"random", "first"}, default="random"
+        How the collection's greedy action is chosen among tied ones (Q-values within a
+        relative ``1e-6`` of the best): "random" draws one uniformly, "first" takes the
+        lowest action (the thesis's, numpy's ``argmax``). A forest's Q-function is
+        piecewise constant, so actions it cannot yet tell apart tie, or differ only by
+        rounding; "first" then always collects the same action there, which on a task with
+        one reward everywhere until the goal (Acrobot-v1: -1 per step) never reaches the
+        goal (``docs/fqi.md``). `predict` stays deterministic: the lowest tied action.
     n_envs : int, default=None
         Envs played side by side while collecting; None: the vector env's own number, or
         16 for any other env form.
@@ -198,7 +208,8 @@ class FQI:
                  samples_per_iteration: int = 2_500, resample_every: int | None = 5,
                  keep_data: bool = True, max_samples: int = 100_000,
                  exploration_fraction: float = 0.1, exploration_initial_eps: float = 1.0,
-                 exploration_final_eps: float = 0.05, n_envs: int | None = None,
+                 exploration_final_eps: float = 0.05, tie_break: str = "random",
+                 n_envs: int | None = None,
                  eval_episodes: int | None = None, eval_seeds: Sequence[int] | None = None,
                  eval_env: EnvLike | None = None, n_jobs: int = 1,
                  log_path: str | os.PathLike[str] | None = None, seed: int | None = None,
@@ -242,6 +253,7 @@ class FQI:
                                                    params["exploration_initial_eps"], 0.0, 1.0)
         self.exploration_final_eps = _check_real("exploration_final_eps",
                                                  params["exploration_final_eps"], 0.0, 1.0)
+        self.tie_break = _check_choice("tie_break", params["tie_break"], _TIE_BREAKS)
         self.samples_per_iteration = _check_int("samples_per_iteration",
                                                 params["samples_per_iteration"], 1)
         resample_every = params["resample_every"]
@@ -608,7 +620,15 @@ class FQI:
         n = len(q)
         explore = self._action_rng.random(n) < self.exploration_rate
         return np.where(explore, self._action_rng.integers(self.n_actions, size=n),
-                        q.argmax(axis=1))
+                        self._greedy(q))
+
+    def _greedy(self, q):
+        """The greedy actions of Q-values ``q``, ties broken as `tie_break` says."""
+        if self.tie_break == "first":
+            return q.argmax(axis=1)
+        best = q.max(axis=1, keepdims=True)
+        tied = q >= best - _TIE_TOLERANCE * np.abs(best)
+        return ((1.0 + self._action_rng.random(q.shape)) * tied).argmax(axis=1)
 
     # ------------------------------------------------------------------ acting
     def q_values(self, observation: Observation) -> np.ndarray:

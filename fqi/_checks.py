@@ -37,6 +37,14 @@ def _check_bool(name, value):
     return bool(value)
 
 
+def _check_choice(name, value, choices):
+    """`value`, one of the strings `choices`."""
+    if not isinstance(value, str) or value not in choices:
+        raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, "
+                         f"got {value!r}")
+    return value
+
+
 def _check_seed(name, value):
     """`value` as None or an int ``>= 0`` (what `numpy.random.SeedSequence` takes)."""
     return None if value is None else _check_int(name, value, 0)

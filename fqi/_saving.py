@@ -6,7 +6,7 @@ import joblib
 
 __all__ = []
 
-_SAVE_FORMAT = 3  # 3: the exploration schedule replaced epsilon
+_SAVE_FORMAT = 4  # 3: the exploration schedule replaced epsilon; 4: tie_break
 
 
 def _write_save(state, path):

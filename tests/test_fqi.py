@@ -17,6 +17,7 @@ import envs
 from boxtrees import BoxExtraTreesRegressor, ObjectSets
 from fqi import FQI, GridObservation, RandomPolicy, evaluate, make_box_forest, make_grid_ridge
 from fqi._collect import _Collector, _Transitions
+from fqi._saving import _SAVE_FORMAT
 from fqi._observations import _observation_format
 
 ENV = "ObjectWorld-v0"
@@ -30,7 +31,7 @@ def small_forest(**params):
 
 # The thesis's protocol, at a small size: what these tests were written for.
 THESIS = dict(gamma=0.5, resample_every=1, keep_data=False, exploration_initial_eps=0.2,
-              exploration_final_eps=0.2)
+              exploration_final_eps=0.2, tie_break="first")
 
 
 def small_agent(regressor=None, **params):
@@ -136,6 +137,7 @@ def test_save_load_round_trip(trained, tmp_path):
     np.testing.assert_array_equal(loaded.q_values(obs), trained.q_values(obs))
     assert loaded.history == trained.history and loaded.iteration == 2
     assert loaded.gamma == trained.gamma and loaded.eval_seeds == trained.eval_seeds
+    assert loaded.tie_break == trained.tie_break == "first"
     assert loaded.observation_space == trained.observation_space
     assert isinstance(loaded.get_env(), envs.BatchedObjectWorld)  # from the saved id
     loaded.learn(n_iterations=1)  # training continues on fresh data
@@ -247,7 +249,8 @@ def test_regimes_collect_when_they_should():
 def test_missing_action_keeps_its_previous_q_function():
     agent = small_agent(ObjectCountQ(), exploration_initial_eps=0.0,
                         exploration_final_eps=0.0, eval_episodes=0).learn(n_iterations=1)
-    # a greedy agent on an object count picks the same action everywhere
+    # every action has the same Q-values: greedy with ties to the first action, the agent
+    # picks action 0 everywhere
     with pytest.warns(RuntimeWarning, match="no transition with action"):
         agent.learn(n_iterations=1)
 
@@ -354,6 +357,7 @@ def test_thesis_run_is_unchanged():
     ({"n_jobs": 1.5}, TypeError, "n_jobs must be an int"),
     ({"verbose": "yes"}, TypeError, "verbose must be an int or a bool"),
     ({"verbose": -1}, ValueError, "verbose must be >= 0"),
+    ({"tie_break": "last"}, ValueError, "tie_break must be one of 'random', 'first'"),
 ])
 def test_bad_parameters(params, error, match):
     with pytest.raises(error, match=match):
@@ -413,10 +417,10 @@ def _truncated_save(agent, path):
     (lambda agent, path: joblib.dump([1, 2], path), "pickle of a list, not an agent"),
     (lambda agent, path: joblib.dump({"rules": {}}, path), "pickle of a dict, not an agent"),
     (lambda agent, path: joblib.dump({"format": 1}, path),
-     "FQI save of format version 1; this version of fqi reads version 3"),
-    (lambda agent, path: joblib.dump({"format": 3, "state": {}}, path),
+     f"FQI save of format version 1; this version of fqi reads version {_SAVE_FORMAT}"),
+    (lambda agent, path: joblib.dump({"format": _SAVE_FORMAT, "state": {}}, path),
      "not an agent saved by FQI.save: it lacks _q, action_space, env, eval_env"),
-    (lambda agent, path: joblib.dump({"format": 3, "state": [1]}, path),
+    (lambda agent, path: joblib.dump({"format": _SAVE_FORMAT, "state": [1]}, path),
      "not an agent saved by FQI.save: it lacks state"),
 ])
 def test_load_names_the_file_and_what_is_wrong(trained, tmp_path, write, match):

@@ -113,3 +113,23 @@ def test_offline_data_is_learned_by_iterations():
         agent.learn(total_timesteps=100)
     agent.learn(n_iterations=3)
     assert [r["new_samples"] for r in agent.history] == [300, 0, 0]
+
+
+@pytest.mark.parametrize("tie_break", ["random", "first"])
+def test_greedy_ties_are_broken_as_tie_break_says(tie_break):
+    agent = cartpole_agent(tie_break=tie_break, exploration_initial_eps=0.0,
+                           exploration_final_eps=0.0)
+    q = np.array([[1.0, 1.0, 0.5]] * 3000 + [[2.0, 2.0 - 1e-7, 2.0 + 1e-3]] * 3000)
+    actions = agent._greedy(q)
+    tied, clear = np.bincount(actions[:3000], minlength=3), actions[3000:]
+    assert (clear == 2).all()  # a gap above the tolerance is no tie
+    if tie_break == "first":
+        assert tied.tolist() == [3000, 0, 0]
+        return
+    assert tied[2] == 0 and abs(tied[0] - 1500) < 150  # uniform over the tied actions
+    near = agent._greedy(np.array([[-18.2093042, -18.2093046, -18.2093037]] * 3000))
+    assert np.bincount(near, minlength=3).min() > 800  # rounding-close values tie
+    # predict stays deterministic: the first of tied actions
+    agent.learn(total_timesteps=300)
+    agent._q.values = lambda batch, n_jobs: np.ones((len(batch), 2))
+    assert (agent.predict(np.zeros((50, 4), dtype=np.float32))[0] == 0).all()

@@ -538,18 +538,26 @@ _CONTROL = {"CartPole-v1": 475.0, "Acrobot-v1": -100.0, "MountainCar-v0": -110.0
             "LunarLander-v3": 200.0}
 
 
+# The runs made before `fqi.FQI` had `tie_break` (its greedy ties went to the first action)
+_FIRST_TIES = {"tie_break": "first"}
+_FIRST_TIES_LABEL = ", first-action ties"
+_CONTROL_FQI = {"FQI, Extra-Trees": "extra-trees",
+                "FQI, Extra-Trees grown out": "extra-trees, grown out",
+                "FQI, boxtrees classic": "box-classic"}
+
+
 def _control(env_id):
     steps = ZOO_STEPS["DQN"][env_id]
+    fqi = {"learner": "fqi", "steps": steps}
     return Experiment(
         f"control_{env_id.split('-')[0].lower()}", "extra",
         f"{env_id}: FQI with its defaults against tuned DQN and PPO", "control",
         env_id=env_id, on_demand=True, defaults={"threshold": _CONTROL[env_id]},
         settings={
-            "FQI, Extra-Trees": {"learner": "fqi", "steps": steps},
-            "FQI, Extra-Trees grown out": {"learner": "fqi", "steps": steps,
-                                           "regressor": "extra-trees, grown out"},
-            "FQI, boxtrees classic": {"learner": "fqi", "regressor": "box-classic",
-                                      "steps": steps},
+            **{label: {**fqi, "regressor": regressor}
+               for label, regressor in _CONTROL_FQI.items()},
+            **{label + _FIRST_TIES_LABEL: {**fqi, "regressor": regressor, "fqi": _FIRST_TIES}
+               for label, regressor in _CONTROL_FQI.items()},
             "DQN (rl-zoo3)": {"learner": "DQN", "hyperparams": ZOO_DQN[env_id],
                               "steps": steps},
             "PPO (rl-zoo3)": {"learner": "PPO", "hyperparams": ZOO_PPO[env_id],
@@ -557,7 +565,9 @@ def _control(env_id):
         notes=f"Mean return on 20 held-out episodes every 5,000 steps. FQI: `fqi.FQI`'s "
               f"defaults with 30 Extra-Trees (scikit-learn's with n_min 10 or grown out, or "
               f"boxtrees' classic splits) "
-              f"for rl-zoo3's DQN budget ({steps:,} steps); DQN and PPO: rl-zoo3's tuned "
+              f"for rl-zoo3's DQN budget ({steps:,} steps), with greedy ties broken at "
+              f"random (the default) or to the first action (the default before "
+              f"`tie_break` existed); DQN and PPO: rl-zoo3's tuned "
               f"settings and budgets; one core per run.")
 
 
@@ -567,10 +577,12 @@ def _control(env_id):
 FQI_DEFAULTS_MEASURED = {
     "gamma": 0.99, "samples_per_iteration": 2_500, "resample_every": 5, "keep_data": True,
     "max_samples": 100_000, "exploration_fraction": 0.1, "exploration_initial_eps": 1.0,
-    "exploration_final_eps": 0.05}
-# The defaults of FQI, measured: variations of one setting at a time on CartPole-v1.
+    "exploration_final_eps": 0.05, "tie_break": "random"}
+# The defaults of FQI, measured: variations of one setting at a time on CartPole-v1, made
+# before `tie_break` existed (so with ties to the first action); then the defaults with ties
+# broken at random.
 _FQI_VARIANTS = {
-    "defaults": {},
+    "first-action ties": {},
     "10 backups per round": {"resample_every": 10},
     "rounds of 1,000 steps": {"samples_per_iteration": 1000, "resample_every": 2},
     "epsilon to 0.2": {"exploration_final_eps": 0.2},
@@ -583,16 +595,21 @@ _FQI_VARIANTS = {
     "epsilon 0.2 from the second round": {"exploration_fraction": 0.0,
                                           "exploration_final_eps": 0.2},
 }
+_GROWN_OUT = {"regressor": "extra-trees, grown out"}
 EXPERIMENTS += (
     *(_control(env_id) for env_id in _CONTROL),
     Experiment(
         "fqi_defaults", "extra", "CartPole-v1: FQI's defaults, one change at a time",
         "control", env_id="CartPole-v1", on_demand=True, seeds=3,
         defaults={"learner": "fqi", "steps": 50_000, "threshold": 475.0},
-        settings={**{label: {"fqi": fqi} for label, fqi in _FQI_VARIANTS.items()},
-                  "trees grown out (n_min 2)": {"regressor": "extra-trees, grown out"}},
+        settings={**{label: {"fqi": {**_FIRST_TIES, **fqi}}
+                     for label, fqi in _FQI_VARIANTS.items()},
+                  "trees grown out (n_min 2)": {**_GROWN_OUT, "fqi": _FIRST_TIES},
+                  "defaults": {},
+                  "defaults, trees grown out": _GROWN_OUT},
         notes="30 Extra-Trees (n_min 10, but where grown out); the evidence for `fqi.FQI`'s "
-              "defaults."),
+              "defaults. Every setting but the last two has greedy ties to the first action "
+              "(`tie_break=\"first\"`, the default before that parameter existed)."),
 )
 
 # Real games seen as objects (on demand: ``--only games_pong``): box FQI against DQN and PPO
