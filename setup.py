@@ -31,7 +31,7 @@ def _extension(name):
 
 setup(
     ext_modules=cythonize(
-        [_extension(name) for name in ("_builder", "_predictor", "_rows")],
+        [_extension(name) for name in ("_builder", "_layout", "_predictor", "_rows", "_splitter")],
         compiler_directives={
             "language_level": 3,
             "boundscheck": False,

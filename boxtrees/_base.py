@@ -9,7 +9,7 @@ from math import ceil
 from numbers import Integral, Real
 
 import numpy as np
-from joblib import Parallel, delayed, effective_n_jobs
+from joblib import effective_n_jobs
 from scipy.sparse import csr_matrix
 from sklearn.base import BaseEstimator, ClassifierMixin, RegressorMixin
 from sklearn.utils._param_validation import Interval, RealNotInt, StrOptions
@@ -17,14 +17,14 @@ from sklearn.utils.class_weight import compute_class_weight, compute_sample_weig
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import _check_sample_weight, check_is_fitted
 
-from ._builder import MAX_GROUP_COLUMNS, TEST_KINDS, build_tree
 from ._index import index_segments
+from ._layout import MAX_GROUP_COLUMNS
 from ._objects import (_FLOAT32_MAX, ObjectInputMixin, check_view_bounds, columns_of,
                        fitted_region, row_error)
 from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
+from ._splitter import TEST_KINDS
 from ._threads import thread_pool
-from ._tree import BoxTree
 from ._typing import SetsOrMatrix
 
 # prediction splits a batch into chunks of at least this many samples, one per thread
@@ -100,26 +100,20 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             max_depth=-1 if self.max_depth is None else self.max_depth,
             max_retries=self.max_retries, refine_tests=bool(self.refine_tests),
         )
-        return _FitData(objects=_TrainingObjects(self, sets), y=np.ldexp(y, y_exponent),
+        objects = _TrainingObjects(self, sets)
+        return _FitData(objects=objects, y=np.ldexp(y, y_exponent),
                         sample_weight=np.ldexp(sample_weight, w_exponent),
                         y_exponent=y_exponent, w_exponent=w_exponent, params=params,
-                        kept=kept, labels=labels)
+                        kept=kept, labels=labels, fitted=self._data_attributes())
 
-    def _grow_trees(self, data, seeds, n_jobs=None, verbose=0, bootstrap=None):
-        """One tree per seed on the `_FitData` ``data`` (with a `_Bootstrap`, each on its own
-        bootstrap sample)."""
-        trees = Parallel(n_jobs=n_jobs, verbose=verbose, prefer="threads")(
-            delayed(_grow_tree)(data.objects, data.y, data.sample_weight, data.params, int(seed),
-                                bootstrap)
-            for seed in seeds
-        )
-        for arrays in trees:     # back in the units of y and of the weights
-            arrays["value"] = np.ldexp(arrays["value"], -data.y_exponent)
-            arrays["impurity"] = np.ldexp(arrays["impurity"], -2 * data.y_exponent)
-            arrays["weighted_n_node_samples"] = np.ldexp(arrays["weighted_n_node_samples"],
-                                                         -data.w_exponent)
-        return [BoxTree.from_builder(self._node_arrays(arrays), self.types_, self.column_groups_,
-                                     self.n_attributes_) for arrays in trees]
+    def _data_attributes(self):
+        """What fitting has learnt about the training data: every fitted attribute
+        (scikit-learn's trailing underscore) but the trees and their out-of-bag estimates,
+        and whether the data was a feature matrix."""
+        return {name: value for name, value in vars(self).items()
+                if (name.endswith("_") and not name.startswith(("_", "oob_"))
+                    and name not in ("tree_", "estimators_"))
+                or name == "_fitted_on_features"}
 
     def _node_arrays(self, arrays):
         """The builder's node arrays as the estimator's trees keep them."""
@@ -235,7 +229,9 @@ class _FitData:
     ``sample_weight`` are those of the samples of positive weight (the mask ``kept`` over
     all the samples), ``y`` and the weights scaled by ``2**y_exponent`` and
     ``2**w_exponent``; ``labels`` are the validated targets of all the samples (the class
-    labels for a classifier).
+    labels for a classifier); ``fitted`` holds the fitted attributes that validating them
+    set on the estimator (`BaseBoxTrees._data_attributes`), which every tree grown on them
+    takes.
     """
 
     objects: object
@@ -246,6 +242,7 @@ class _FitData:
     params: _TreeParams
     kept: np.ndarray
     labels: np.ndarray
+    fitted: dict
 
 
 @dataclass(frozen=True, eq=False)
@@ -304,13 +301,6 @@ def _class_weight_factors(class_weight, labels, sample_weight):
     factors[weighted] = compute_sample_weight(
         per_output[0] if len(per_output) == 1 else per_output, columns)
     return factors
-
-
-def _grow_tree(objects, y, sample_weight, params, seed, bootstrap):
-    """One tree; with a `_Bootstrap`, on the bootstrap sample of its seed."""
-    if bootstrap is not None:
-        sample_weight = bootstrap.weights(seed, sample_weight)
-    return build_tree(objects, y, sample_weight, params, seed)
 
 
 class RegressionTargets(RegressorMixin):

@@ -14,6 +14,7 @@ from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import check_is_fitted
 
 from ._base import BaseBoxTrees, ClassificationTargets, RegressionTargets
+from ._builder import build_tree
 from ._tree import BoxTree
 from ._typing import RandomStateLike, SetsOrMatrix, TestType, fit_context
 
@@ -95,9 +96,26 @@ class _SingleTree(BaseBoxTrees):
         -------
         self : estimator
         """
-        data = self._fit_data(X, y, sample_weight)
-        (self.tree_,) = trees = self._grow_trees(data, [_tree_seed(self.random_state)])
-        self._pack(trees)
+        return self._fit(self._fit_data(X, y, sample_weight), _tree_seed(self.random_state))
+
+    def _fit(self, data, seed, bootstrap=None):
+        """Grow the tree of ``seed`` on validated training data (`_FitData`; with a
+        `_Bootstrap`, on the bootstrap sample of ``seed``), taking the fitted attributes of
+        the data: a forest asks each of its trees to fit so, on the data it validated."""
+        for name, value in data.fitted.items():
+            setattr(self, name, value)
+        weight = data.sample_weight
+        if bootstrap is not None:
+            weight = bootstrap.weights(seed, weight)
+        arrays = build_tree(data.objects, data.y, weight, data.params, seed)
+        # back in the units of y and of the weights
+        arrays["value"] = np.ldexp(arrays["value"], -data.y_exponent)
+        arrays["impurity"] = np.ldexp(arrays["impurity"], -2 * data.y_exponent)
+        arrays["weighted_n_node_samples"] = np.ldexp(arrays["weighted_n_node_samples"],
+                                                     -data.w_exponent)
+        self.tree_ = BoxTree.from_builder(self._node_arrays(arrays), self.types_,
+                                          self.column_groups_, self.n_attributes_)
+        self._pack([self.tree_])
         return self
 
     def _trees(self):

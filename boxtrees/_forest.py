@@ -9,6 +9,7 @@ from typing import Any, Literal, Self
 
 import numpy as np
 from numpy.typing import ArrayLike
+from joblib import Parallel, delayed
 from scipy.sparse import csr_matrix
 from sklearn.metrics import r2_score
 from sklearn.utils import check_random_state
@@ -145,20 +146,14 @@ class _Forest(BaseBoxTrees):
         if self.bootstrap:
             kept = data.labels[data.kept]
             bootstrap = _Bootstrap(self._n_draws(len(kept)), kept if subsample else None)
-        trees = self._grow_trees(data, seeds, self.n_jobs, self.verbose, bootstrap)
         params = {name: getattr(self, name) for name in self._tree_class._get_param_names()
                   if name != "random_state"}
-        # what fitting taught the forest about the data, its trees know too: every fitted
-        # attribute (scikit-learn's trailing underscore) but the trees themselves
-        fitted = {name: value for name, value in self.__dict__.items()
-                  if (name.endswith("_") and not name.startswith("_") and name != "estimators_")
-                  or name == "_fitted_on_features"}
-        self.estimators_ = list(grown)
-        for tree, seed in zip(trees, seeds):
-            estimator = self._tree_class(**params, random_state=int(seed))
-            estimator.__dict__.update(fitted, tree_=tree)
-            estimator._pack([tree])
-            self.estimators_.append(estimator)
+        # each new tree fits itself on the data validated here, taking what they taught the
+        # forest (its fitted attributes)
+        trees = [self._tree_class(**params, random_state=int(seed)) for seed in seeds]
+        self.estimators_ = list(grown) + Parallel(
+            n_jobs=self.n_jobs, verbose=self.verbose, prefer="threads"
+        )(delayed(tree._fit)(data, tree.random_state, bootstrap) for tree in trees)
         self._pack(self._trees())
         if self.oob_score:
             self._set_oob_attributes(X, data, bootstrap)

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.sparse import issparse
 
-from ._rows import MAX_TYPE as _MAX_TYPE
+from ._layout import MAX_TYPE as _MAX_TYPE
 from ._rows import RowProblem, scan_offsets, scan_rows
 
 __all__ = ["ObjectSets"]

@@ -1,8 +1,9 @@
 """Forest traversal: predictions and leaf indices for batches of object sets.
 
-A `PackedForest` holds the node tests of fitted trees as one array of 40-byte records (a left
-child follows its parent, so a root-to-leaf walk touches few cache lines): a record names the
-two attributes its box bounds (a box over more keeps the others in a side table).
+A `PackedForest` holds the node tests of fitted trees as one array of 40-byte records, the
+``boxtrees_node`` of ``_tree.pxd`` (a left child follows its parent, so a root-to-leaf walk
+touches few cache lines): a record names the two attributes its box bounds (a box over more
+keeps the others in a side table).
 It copies and validates the trees it is built from and keeps its arrays private, so no value
 reachable from Python can send a walk outside them.
 
@@ -18,25 +19,18 @@ import numpy as np
 cimport numpy as cnp
 from libc.math cimport INFINITY
 
+from ._layout import EXTRA_DTYPE, MAX_ATTRIBUTES, NODE_DTYPE
+
+from ._simd cimport boxtrees_kernels, boxtrees_select_kernels
+from ._tree cimport MAX_TYPE, TREE_LEAF, boxtrees_extra, boxtrees_node
 from ._utils cimport (
-    BAD_OFFSETS, MAX_TYPE, ROW_OK, ROW_TYPE_TOO_LARGE, TREE_LEAF, coord_t, float64_t, int32, intp_t,
-    row_problem,
+    BAD_OFFSETS, ROW_OK, ROW_TYPE_TOO_LARGE, coord_t, float64_t, intp_t, row_problem,
 )
-from ._simd cimport boxtrees_extra, boxtrees_kernels, boxtrees_node, boxtrees_select_kernels
 
 cnp.import_array()
 
 cdef enum:
     BLOCK = 64
-
-
-cdef boxtrees_node _layout
-cdef boxtrees_extra _extra_layout
-# the traversal's records as NumPy dtypes, read off the C structs of _simd.h
-NODE_DTYPE = np.asarray(<boxtrees_node[:1]>&_layout).dtype
-EXTRA_DTYPE = np.asarray(<boxtrees_extra[:1]>&_extra_layout).dtype
-# the records name attributes with int16
-MAX_ATTRIBUTES = 2**15 - 1
 
 # the traversal kernel (see _simd.h)
 cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)

@@ -1,18 +1,10 @@
 """Validation of object rows and batch offsets in one pass."""
 from enum import IntEnum
 
-from ._utils cimport MAX_TYPE as _MAX_TYPE
-from ._utils cimport TREE_LEAF as _TREE_LEAF
-from ._utils cimport TREE_UNDEFINED as _TREE_UNDEFINED
 from ._utils cimport (
     BAD_OFFSETS, ROW_NEGATIVE_TYPE, ROW_NON_INTEGER_TYPE, ROW_NOT_FINITE, ROW_OK, ROW_TOO_LARGE,
     ROW_TYPE_TOO_LARGE, intp_t, real_t, row_problem,
 )
-
-# the core's constants (boxtrees/_utils.pxd), for the Python modules
-MAX_TYPE = _MAX_TYPE
-TREE_LEAF = _TREE_LEAF
-TREE_UNDEFINED = _TREE_UNDEFINED
 
 
 def scan_rows(const real_t[:, ::1] data, double max_coordinate, double max_type):

@@ -37,11 +37,12 @@ typedef int64_t (*boxtrees_partition_fn)(float *xs, float *ys, int32_t *sid, int
                                          const int32_t *new_id, int32_t mid, float *tmp_x,
                                          float *tmp_y, int32_t *tmp_sid);
 
-/* A node test as the traversal reads it (boxtrees._predictor.NODE_DTYPE): child ids local to
-   the tree, left = -1 at a leaf (TREE_LEAF); the box (xmin, xmax, ymin, ymax) bounds the
-   attributes x_column and y_column (the same column, with an unbounded y extent, for a box
-   over one attribute). A box over more attributes bounds the others in `extra`: entries
-   extras[extra], extras[extra + 1], ... up to one whose column is -1; extra = -1: none. */
+/* A node test as the traversal reads it (declared for Cython in _tree.pxd; its NumPy dtype is
+   boxtrees._layout.NODE_DTYPE): child ids local to the tree, left = -1 at a leaf (TREE_LEAF);
+   the box (xmin, xmax, ymin, ymax) bounds the attributes x_column and y_column (the same
+   column, with an unbounded y extent, for a box over one attribute). A box over more
+   attributes bounds the others in `extra`: entries extras[extra], extras[extra + 1], ... up
+   to one whose column is -1; extra = -1: none. */
 typedef struct {
     int32_t left;
     int32_t right;
@@ -282,8 +283,9 @@ static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes,
 }
 #endif
 
-/* The fastest kernels this CPU runs, or the portable ones when `allow_simd` is 0. */
-static boxtrees_kernels boxtrees_select_kernels(int allow_simd)
+/* The fastest kernels this CPU runs, or the portable ones when `allow_simd` is 0 (inline: the
+   modules that include this header for its records alone do not call it). */
+static inline boxtrees_kernels boxtrees_select_kernels(int allow_simd)
 {
     boxtrees_kernels k = {boxtrees_compact_portable, boxtrees_compact_box_portable,
                           boxtrees_partition_portable, boxtrees_find_leaf_portable};

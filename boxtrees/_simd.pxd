@@ -1,23 +1,10 @@
-# The kernels of _simd.h and the records they read, declared once for the Cython modules.
-from libc.stdint cimport int16_t
-
+# The kernels of _simd.h, declared once for the Cython modules (the records they read are
+# declared in _tree.pxd).
+from ._tree cimport boxtrees_extra, boxtrees_node
 from ._utils cimport coord_t, int32, intp_t
 
 
 cdef extern from "_simd.h":
-    ctypedef struct boxtrees_node:      # a node test as the traversal reads it
-        int32 left
-        int32 right
-        int32 object_type
-        int32 threshold
-        int16_t x_column
-        int16_t y_column
-        int32 extra
-        coord_t box[4]
-    ctypedef struct boxtrees_extra:     # one more bounded attribute of a box
-        int32 column
-        coord_t low
-        coord_t high
     ctypedef struct boxtrees_kernels:
         intp_t (*compact)(const coord_t* ys, const int32* sid, intp_t n, coord_t ymin,
                           coord_t ymax, int32* out) noexcept nogil

@@ -7,8 +7,7 @@ from typing import Self
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._builder import NODE_FIELDS
-from ._rows import TREE_LEAF, TREE_UNDEFINED
+from ._layout import NODE_FIELDS, TREE_LEAF, TREE_UNDEFINED
 
 __all__ = ["BoxTree", "TREE_LEAF", "TREE_UNDEFINED"]
 # a tree's node arrays: the builder's, with the box over every attribute in place of the

@@ -1,4 +1,5 @@
-# Shared C-level types and the per-tree random number generator of the Cython core.
+# Shared C-level types, the check of an object row and the per-tree random number generator
+# of the Cython core (the node layout and its constants are in _tree.pxd).
 from libc.math cimport floor, isfinite
 from libc.stdint cimport int32_t, int64_t, uint8_t, uint64_t
 
@@ -8,11 +9,6 @@ ctypedef int32_t int32
 ctypedef int64_t intp_t
 ctypedef uint8_t uint8
 ctypedef uint64_t uint64
-
-cdef enum:
-    TREE_LEAF = -1            # children_* of a leaf
-    TREE_UNDEFINED = -2       # object_type / threshold of a leaf
-    MAX_TYPE = 16777216       # 2**24: float32 holds every integer type id below it exactly
 
 cdef enum RowProblem:
     # what is wrong with an object row [f_1, ..., f_d, type] (or with a batch's offsets),
@@ -49,13 +45,6 @@ cdef inline int row_problem(const real_t* row, intp_t n_attributes, double max_c
     if t >= max_type:
         return ROW_TYPE_TOO_LARGE
     return ROW_OK
-
-
-cdef enum TestKind:
-    RANDOM = 0
-    FIXED = 1
-    BOUNDED = 2
-    CLASSIC = 3
 
 
 cdef inline uint64 rand_u64(uint64* state) noexcept nogil:

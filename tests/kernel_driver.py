@@ -18,6 +18,8 @@ package = types.ModuleType("boxtrees")
 package.__path__ = [str(Path(__file__).resolve().parents[1] / "boxtrees")]
 sys.modules["boxtrees"] = package
 _builder = importlib.import_module("boxtrees._builder")
+_layout = importlib.import_module("boxtrees._layout")
+_splitter = importlib.import_module("boxtrees._splitter")
 _predictor = importlib.import_module("boxtrees._predictor")
 _rows = importlib.import_module("boxtrees._rows")
 _tree = importlib.import_module("boxtrees._tree")
@@ -48,7 +50,7 @@ def training_arrays(rng, n, per_sample, n_types, n_bands, spread, groups):
     band_edges = np.array([edges if len(columns) > 1 else one_band for columns in groups])
     x, y, sample_of, object_of, segment_ptr = _index.index_segments(
         data, sample, data[:, d].astype(np.intp), groups, n_types, band_edges)
-    width = _builder.MAX_GROUP_COLUMNS
+    width = _layout.MAX_GROUP_COLUMNS
     bounds = np.tile(np.array([-1, 1] * width, dtype=np.float32), (len(groups) * n_types, 1))
     extra = np.full((len(groups), width - 2), -1)
     for g, columns in enumerate(groups):
@@ -83,7 +85,7 @@ def main():
         target, weight = rng.normal(size=n), rng.uniform(0.5, 2, n)
         for test_type in ("random", "fixed", "bounded", "classic"):
             for simd in (True, False):
-                _builder._set_simd(simd)
+                _splitter._set_simd(simd)
                 _predictor._set_simd(simd)
                 # one output, then two (multi-output sums)
                 targets = target if seed_outputs(case) == 1 else np.column_stack([target, weight])
@@ -103,7 +105,7 @@ def main():
     # a feature matrix, read in place whatever its strides: the column splitter
     n, n_features = 80, 3
     values = rng.normal(size=(n, 2 * n_features)).astype(np.float32)
-    width = _builder.MAX_GROUP_COLUMNS
+    width = _layout.MAX_GROUP_COLUMNS
     bounds = np.zeros((n_features, 2 * width), dtype=np.float32)
     bounds[:, 2:4] = [-np.inf, np.inf]
     half = np.full((n_features, width), 0.3)
@@ -161,8 +163,8 @@ def corrupted_inputs(forest, trees, data, offsets):
         zeros = np.zeros(len(sample), np.float32)
         grow(SimpleNamespace(x=zeros, y=zeros, sample_of=sample, segment_ptr=[0, len(sample)],
                              band_edges=[[-np.inf, np.inf]],
-                             bounds=np.zeros((1, 2 * _builder.MAX_GROUP_COLUMNS), np.float32),
-                             half_widths=np.ones((1, _builder.MAX_GROUP_COLUMNS)),
+                             bounds=np.zeros((1, 2 * _layout.MAX_GROUP_COLUMNS), np.float32),
+                             half_widths=np.ones((1, _layout.MAX_GROUP_COLUMNS)),
                              group_sizes=[1]),
              np.zeros(2), np.ones(2), "fixed")
     except ValueError:

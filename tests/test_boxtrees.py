@@ -278,15 +278,15 @@ def test_max_depth_limits_trees():
 
 
 def test_simd_and_portable_kernels_grow_identical_trees():
-    from boxtrees import _builder
+    from boxtrees import _splitter
 
     X, y = make_box_regression(1500, random_state=0)
     params = dict(n_estimators=3, n_tests=50, min_samples_split=10, random_state=0)
     try:
-        _builder._set_simd(False)
+        _splitter._set_simd(False)
         portable = thesis_forest(test_type="random", **params).fit(X, y)
     finally:
-        _builder._set_simd(True)
+        _splitter._set_simd(True)
     simd = thesis_forest(test_type="random", **params).fit(X, y)
     for a, b in zip(trees_of(portable), trees_of(simd)):
         np.testing.assert_array_equal(a.children_left, b.children_left)

@@ -13,7 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from boxtrees import BoxExtraTreesRegressor, BoxTree, GridCounts, ObjectSets, make_box_regression
-from boxtrees._builder import MAX_GROUP_COLUMNS, build_tree
+from boxtrees._builder import build_tree
+from boxtrees._layout import MAX_GROUP_COLUMNS
 from conftest import THESIS_FOREST
 from boxtrees._predictor import PackedForest, apply_leaves, predict_mean
 

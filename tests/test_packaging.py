@@ -27,7 +27,7 @@ import boxtrees
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("boxtrees", "envs", "fqi")
-EXTENSIONS = ("_builder", "_predictor", "_rows")
+EXTENSIONS = ("_builder", "_layout", "_predictor", "_rows", "_splitter")
 RUNTIME = {"numpy", "scipy", "scikit-learn", "joblib"}
 
 pytestmark = pytest.mark.skipif(
