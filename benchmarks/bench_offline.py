@@ -72,7 +72,7 @@ DATASETS = ("random", "medium")
 MEDIUM_TRAINING_STEPS = 15_000
 MEDIUM_EPSILON = 0.2
 # Envs played side by side while collecting: one per 200 transitions, at most 50 (1,000
-# steps each for 50,000 transitions: two whole CartPole episodes at least).
+# steps each for 50,000 transitions: room for two episodes of CartPole's 500 steps).
 COLLECT_STEPS_PER_ENV, MAX_COLLECT_ENVS = 200, 50
 FQI_METHODS = {"fqi-nmin10": 10, "fqi-grown": 2}  # min_samples_split of the Extra-Trees
 D3RLPY_METHODS = {
@@ -255,7 +255,10 @@ def held_out_return(policy):
     from fqi import evaluate
 
     env = gym.make_vec(ENV_ID, EVAL_EPISODES, vectorization_mode="sync")
-    return evaluate(policy, env, n_episodes=EVAL_EPISODES).mean
+    try:
+        return evaluate(policy, env, n_episodes=EVAL_EPISODES).mean
+    finally:
+        env.close()
 
 
 def run_fqi(data, method, seed, n_iterations):
