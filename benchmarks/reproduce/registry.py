@@ -595,7 +595,6 @@ _FQI_VARIANTS = {
     "epsilon 0.2 from the second round": {"exploration_fraction": 0.0,
                                           "exploration_final_eps": 0.2},
 }
-_GROWN_OUT = {"regressor": "extra-trees, grown out"}
 EXPERIMENTS += (
     *(_control(env_id) for env_id in _CONTROL),
     Experiment(
@@ -604,12 +603,15 @@ EXPERIMENTS += (
         defaults={"learner": "fqi", "steps": 50_000, "threshold": 475.0},
         settings={**{label: {"fqi": {**_FIRST_TIES, **fqi}}
                      for label, fqi in _FQI_VARIANTS.items()},
-                  "trees grown out (n_min 2)": {**_GROWN_OUT, "fqi": _FIRST_TIES},
-                  "defaults": {},
-                  "defaults, trees grown out": _GROWN_OUT},
+                  "trees grown out (n_min 2)": {"regressor": "extra-trees, grown out",
+                                                "fqi": _FIRST_TIES},
+                  "defaults": {"same_as": "control_cartpole/FQI, Extra-Trees"},
+                  "defaults, trees grown out": {
+                      "same_as": "control_cartpole/FQI, Extra-Trees grown out"}},
         notes="30 Extra-Trees (n_min 10, but where grown out); the evidence for `fqi.FQI`'s "
               "defaults. Every setting but the last two has greedy ties to the first action "
-              "(`tie_break=\"first\"`, the default before that parameter existed)."),
+              "(`tie_break=\"first\"`, the default before that parameter existed); the last "
+              "two are control_cartpole's runs (5 seeds)."),
 )
 
 # Real games seen as objects (on demand: ``--only games_pong``): box FQI against DQN and PPO
