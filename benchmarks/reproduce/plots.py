@@ -114,7 +114,8 @@ def versus_steps(experiment, stats, curves, budget, ylabel="reward per 20,000 gr
             references += 1
             ax.axhline(s.score, ls="--", lw=1.0, color=colour)
             ax.annotate(f"{label} ({s.score:,.0f})", (0, s.score), xytext=(2, 3),
-                        textcoords="offset points", fontsize=7, color=colour)
+                        xycoords=("axes fraction", "data"), textcoords="offset points",
+                        fontsize=7, color=colour)
             continue
         x, mean, sd = curves[label]
         ax.plot(x, mean, marker="o", markersize=3, label=f"{label} ({s.score:,.0f}, "
