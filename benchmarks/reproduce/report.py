@@ -7,7 +7,7 @@ from pathlib import Path
 from . import plots
 from .budgets import EVAL_REFERENCE_STEPS
 from .kinds import KINDS
-from .registry import EXPERIMENTS, REGISTRY, resolve
+from .registry import EXPERIMENTS, REGISTRY
 from .runner import gather, setting_units
 from .stats import last_window
 
@@ -49,8 +49,8 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
     sections, summary, rows, measured = [], {}, [], {}
     for experiment in EXPERIMENTS:
         stats, runs = gather(experiment, budget, out, seeds)
-        if experiment.on_demand and not any(resolve(experiment, label)[0] is experiment
-                                            for label in stats):
+        if experiment.on_demand and all("same_as" in experiment.settings[label]
+                                        for label in stats):
             continue  # not run yet: only settings shared with (``same_as``) others have runs
         planned = sum(len(setting_units(experiment, label, budget, out, seeds))
                       for label in experiment.settings)
