@@ -25,7 +25,7 @@ from ._envs import (_check_env, _close_built, _evaluation_vector, _make_vector, 
 from ._evaluate import _eval_seeds, evaluate
 from ._logger import CSVLogger, _KeyValueLogger
 from ._observations import _ObjectRows, _observation_format
-from ._q_function import _checked_prediction, _QFunction
+from ._q_function import _check_leaf_means, _checked_prediction, _QFunction
 from ._saving import _read_save, _write_save
 from ._typing import Callback, Dataset, EnvLike, Logger, Observation, Regressor
 
@@ -68,7 +68,9 @@ class FQI:
        replace it;
     2. *targets*: ``r`` at iteration 0, then ``r + gamma * max_a Q_{n-1}(s', a)`` for every
        transition in the data set (no bootstrap after a termination; a truncation, such as
-       a time limit, is bootstrapped through with the true final observation);
+       a time limit, is bootstrapped through with the true final observation), then
+       `leaf_backups` more backups on ``Q_{n-1}``'s trees with only their leaf values
+       recomputed;
     3. *fit* ``Q_n``: one clone of `regressor` per action on the transitions with that
        action;
     4. *evaluate*: greedy play, one episode per seed of `eval_seeds` (`fqi.evaluate`),
@@ -123,6 +125,15 @@ class FQI:
         rounding; "first" then always collects the same action there, which on a task with
         one reward everywhere until the goal (Acrobot-v1: -1 per step) never reaches the
         goal (``docs/fqi.md``). `predict` stays deterministic: the lowest tied action.
+    leaf_backups : int, default=0
+        Fitted-Q backups before each fit that keep ``Q_{n-1}``'s trees and recompute only
+        their leaves' values, as means of the current targets (a frozen-structure
+        Extra-Trees, Ernst et al., 2005): value then travels ``leaf_backups + 1`` steps per
+        fit instead of one, each extra backup for about the cost of a prediction. Needs a
+        forest with ``apply`` that predicts the mean of its trees' leaf means, checked here:
+        scikit-learn's ``ExtraTreesRegressor``, or `boxtrees.BoxExtraTreesRegressor` with
+        ``bootstrap=False`` (a bootstrap sample weighs the leaf means). Memory: one leaf id
+        per transition and tree, and per next state, tree and action.
     n_envs : int, default=None
         Envs played side by side while collecting; None: the vector env's own number, or
         16 for any other env form.
@@ -209,7 +220,7 @@ class FQI:
                  keep_data: bool = True, max_samples: int = 100_000,
                  exploration_fraction: float = 0.1, exploration_initial_eps: float = 1.0,
                  exploration_final_eps: float = 0.05, tie_break: str = "random",
-                 n_envs: int | None = None,
+                 leaf_backups: int = 0, n_envs: int | None = None,
                  eval_episodes: int | None = None, eval_seeds: Sequence[int] | None = None,
                  eval_env: EnvLike | None = None, n_jobs: int = 1,
                  log_path: str | os.PathLike[str] | None = None, seed: int | None = None,
@@ -254,6 +265,11 @@ class FQI:
         self.exploration_final_eps = _check_real("exploration_final_eps",
                                                  params["exploration_final_eps"], 0.0, 1.0)
         self.tie_break = _check_choice("tie_break", params["tie_break"], _TIE_BREAKS)
+        self.leaf_backups = _check_int("leaf_backups", params["leaf_backups"], 0)
+        if self.leaf_backups and not callable(getattr(regressor, "apply", None)):
+            raise TypeError(f"leaf_backups needs a regressor with an apply method (the leaf of "
+                            f"each sample in each tree, as scikit-learn's forests have); "
+                            f"{type(regressor).__name__} has none")
         self.samples_per_iteration = _check_int("samples_per_iteration",
                                                 params["samples_per_iteration"], 1)
         resample_every = params["resample_every"]
@@ -332,8 +348,10 @@ class FQI:
         """Fit a clone of the regressor on `batch` (zero targets) and check its predictions,
         so that a regressor that cannot take these observations fails now."""
         model = clone(self.regressor)
+        # distinct targets when the leaves' means are checked (leaf_backups), else zeros
+        y = np.arange(len(batch), dtype=float) * self.leaf_backups
         try:
-            prediction = model.fit(batch, np.zeros(len(batch))).predict(batch)
+            prediction = model.fit(batch, y).predict(batch)
         except (TypeError, ValueError) as exc:
             hint = ""
             if isinstance(observations, _ObjectRows):
@@ -348,6 +366,8 @@ class FQI:
         _checked_prediction(prediction, len(batch),
                             lambda: f"{self.regressor!r}, fitted on the env's first "
                                     f"observations,")
+        if self.leaf_backups:
+            _check_leaf_means(model, batch, y)
 
     def get_env(self) -> VectorEnv | None:
         """The training vector env (None for an agent loaded without an env)."""
@@ -579,13 +599,16 @@ class FQI:
 
     def _targets(self, data):
         """``r`` before any fit, then ``r + gamma * max_a Q_{n-1}(s', a)`` (no bootstrap
-        after a termination)."""
+        after a termination), then `leaf_backups` backups on ``Q_{n-1}``'s trees."""
         targets = data.rewards.copy()
         if self._q is not None:
             future = data.next_values  # known when the data was just collected with Q_{n-1}
             if future is None:
                 future = self._q_values(data.next_states).max(axis=1)
-            targets += self.gamma * np.where(data.terminated, 0.0, future)
+            discounts = np.where(data.terminated, 0.0, self.gamma)
+            targets += discounts * future
+            if self.leaf_backups:
+                targets = self._q.backups(data, targets, discounts, self.leaf_backups)
         data.next_values = None  # stale once Q_n is fitted
         return targets
 

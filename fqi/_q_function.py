@@ -48,6 +48,39 @@ class _QFunction:
             models.append(model.fit(data.states[mask], targets[mask]))
         return cls(models, iteration)
 
+    def backups(self, data, targets, discounts, n_backups):
+        """`targets` after `n_backups` fitted-Q backups that keep these models' trees.
+
+        Each backup sets every leaf's value to the mean target of the transitions of the
+        data set (of the leaf's action) that reach it, and then every target to ``r +
+        discount * max_a Q(s', a)``, ``Q(s', a)`` the mean over the trees of the values of
+        the leaves ``s'`` reaches (a leaf no transition reaches is left out of that mean; a
+        next state with no such leaf in any tree keeps the model's own prediction). With
+        the structure fixed this is a kernel-based value iteration, a contraction: value
+        travels one step per backup for the cost of two table lookups per tree.
+
+        Parameters
+        ----------
+        data : _Transitions
+        targets : ndarray of shape (len(data),)
+            The first backup's targets.
+        discounts : ndarray of shape (len(data),)
+            ``gamma``, or 0 after a termination.
+        n_backups : int
+
+        Returns
+        -------
+        targets : ndarray of shape (len(data),)
+        """
+        tables = [_LeafTable(model, data.states[data.actions == action], data.next_states)
+                  for action, model in enumerate(self.models)]
+        q = np.empty((len(data), len(self.models)))
+        for _ in range(n_backups):
+            for action, table in enumerate(tables):
+                q[:, action] = table.next_values(targets[data.actions == action])
+            targets = data.rewards + discounts * q.max(axis=1)
+        return targets
+
     def values(self, batch, n_jobs=1):
         """``Q(s, a)`` of every action for the observations of `batch`, shape ``(n,
         n_actions)``, predicted in up to `n_jobs` threads (one action each) and checked to be
@@ -80,3 +113,66 @@ def _checked_prediction(prediction, n, describe):
                          f"observation")
     raise ValueError(f"{model} predicted non-finite Q-values (NaN or inf) for {bad.sum()} "
                      f"of {n} observations; a regressor must predict finite values")
+
+
+class _LeafTable:
+    """Where the transitions of one action, and every next state, fall in `model`'s trees.
+
+    ``model.apply(X)`` must give each sample's leaf in each tree, shape ``(n, n_trees)``
+    (or ``(n,)`` for a single tree), and ``model.predict`` the mean over the trees of the
+    leaves' mean training target (`_check_leaf_means` checks a fitted model).
+    """
+
+    def __init__(self, model, states, next_states):
+        next_leaves = _leaves(model, next_states)
+        leaves = (_leaves(model, states) if len(states)  # none: an action not in the data
+                  else np.empty((0, next_leaves.shape[1]), dtype=next_leaves.dtype))
+        n_nodes = 1 + max(leaves.max(initial=0), next_leaves.max(initial=0))
+        self._size = n_nodes * leaves.shape[1]
+        index = np.int32 if self._size < 2**31 else np.intp  # half the memory when it can
+        offsets = (np.arange(leaves.shape[1]) * n_nodes).astype(index)
+        self._leaves = (leaves.astype(index) + offsets).ravel()  # one table for all trees
+        self._next = next_leaves.astype(index) + offsets
+        counts = np.bincount(self._leaves, minlength=self._size)
+        self._reached = counts[self._next] > 0
+        self._n_reached = self._reached.sum(axis=1)
+        self._counts = np.maximum(counts, 1)
+        self._alone = np.flatnonzero(self._n_reached == 0)  # reaches no leaf with data
+        self._own = model.predict(next_states[self._alone]) if len(self._alone) else None
+
+    def next_values(self, targets):
+        """``Q(s', a)`` for every next state, the leaves holding the mean of `targets` (one
+        per transition of this action)."""
+        n_trees = self._next.shape[1]
+        sums = np.bincount(self._leaves, weights=np.repeat(targets, n_trees),
+                           minlength=self._size)
+        values = np.where(self._reached, (sums / self._counts)[self._next], 0.0)
+        mean = values.sum(axis=1) / np.maximum(self._n_reached, 1)
+        if self._own is not None:
+            mean[self._alone] = self._own
+        return mean
+
+
+def _leaves(model, X):
+    """``model.apply(X)`` as leaf ids of shape (n, n_trees)."""
+    leaves = np.asarray(model.apply(X))
+    if leaves.ndim == 1:
+        leaves = leaves[:, None]
+    if leaves.ndim != 2 or leaves.shape[0] != len(X) or not np.issubdtype(leaves.dtype,
+                                                                           np.integer):
+        raise ValueError(f"{model!r}.apply gave an array of shape {leaves.shape} and dtype "
+                         f"{leaves.dtype} for {len(X)} samples; leaf_backups needs leaf ids "
+                         f"of shape (n_samples, n_trees)")
+    return leaves
+
+
+def _check_leaf_means(model, X, y):
+    """Check that `model`, fitted on ``(X, y)``, predicts the mean over its trees of its
+    leaves' mean target (what `_QFunction.backups` relies on); ValueError if not."""
+    table = _LeafTable(model, X, X)
+    if not np.allclose(table.next_values(y), model.predict(X), rtol=1e-6, atol=1e-9):
+        raise ValueError(f"leaf_backups needs a regressor that predicts the mean over its "
+                         f"trees of the mean training target in each leaf (a forest without "
+                         f"bootstrap, such as scikit-learn's ExtraTreesRegressor or "
+                         f"boxtrees.BoxExtraTreesRegressor(bootstrap=False)); {model!r} "
+                         f"predicts otherwise")

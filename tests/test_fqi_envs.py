@@ -490,9 +490,9 @@ def test_evaluate_and_a_failed_set_env_close_the_envs_they_build_and_no_other():
 
 
 def test_save_load_round_trip_on_a_box_env(tmp_path):
-    agent = FQI(classic_forest(), "CartPole-v1", gamma=0.9, samples_per_iteration=200,
-                resample_every=1, max_samples=1000, n_envs=4, eval_episodes=2,
-                seed=3).learn(n_iterations=2)
+    agent = FQI(classic_forest(bootstrap=False), "CartPole-v1", gamma=0.9,
+                samples_per_iteration=200, resample_every=1, max_samples=1000,
+                leaf_backups=2, n_envs=4, eval_episodes=2, seed=3).learn(n_iterations=2)
     agent.save(tmp_path / "agent.joblib")
     loaded = FQI.load(tmp_path / "agent.joblib")
     for name in FQI._param_names():  # every constructor parameter, with no list kept by hand

@@ -1,14 +1,18 @@
 """`FQI.learn` in stable-baselines3's shape: exact step counts, collection rounds with several
-backups each, the exploration schedule, and the defaults learning on a small Box env and a
-small object-set env."""
+backups each, the backups on fixed trees, the exploration schedule, and the defaults learning
+on a small Box env and a small object-set env."""
 import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium import spaces
-from sklearn.ensemble import ExtraTreesRegressor
+from sklearn.ensemble import ExtraTreesRegressor, RandomForestRegressor
+from sklearn.linear_model import Ridge
+from sklearn.tree import DecisionTreeRegressor
 
 from boxtrees import BoxExtraTreesRegressor
 from fqi import FQI, RandomPolicy, evaluate
+from fqi._collect import _Transitions
+from fqi._q_function import _QFunction
 
 
 def cartpole_agent(**params):
@@ -37,6 +41,96 @@ def test_the_buffer_keeps_the_latest_transitions():
     assert [r["n_samples"] for r in agent.history][-2:] == [700, 700]
     replaced = cartpole_agent(keep_data=False).learn(total_timesteps=900)
     assert {r["n_samples"] for r in replaced.history} == {300}
+
+
+def _brute_force_backup(q, data, targets, discounts):
+    """One backup on `q`'s trees, leaf by leaf and tree by tree."""
+    future = np.empty((len(data), len(q.models)))
+    for action, model in enumerate(q.models):
+        mine = data.actions == action
+        next_leaves = np.asarray(model.apply(data.next_states)).reshape(len(data), -1)
+        leaves = (np.asarray(model.apply(data.states[mine])).reshape(mine.sum(), -1)
+                  if mine.any() else np.empty((0, next_leaves.shape[1])))
+        for i in range(len(data)):
+            values = [targets[mine][leaves[:, t] == next_leaves[i, t]].mean()
+                      for t in range(leaves.shape[1]) if (leaves[:, t] == next_leaves[i, t]).any()]
+            future[i, action] = (np.mean(values) if values
+                                 else model.predict(data.next_states[i:i + 1])[0])
+    return data.rewards + discounts * future.max(axis=1)
+
+
+@pytest.mark.parametrize("regressor", [
+    ExtraTreesRegressor(n_estimators=4, min_samples_split=10, random_state=0),
+    DecisionTreeRegressor(min_samples_leaf=5, random_state=0),
+    BoxExtraTreesRegressor(n_estimators=4, test_type="classic", min_samples_split=10,
+                           bootstrap=False, random_state=0, n_jobs=1)],
+    ids=["extra-trees", "tree", "box"])
+def test_backups_on_fixed_trees_recompute_the_leaf_means(regressor):
+    rng = np.random.default_rng(0)
+    n = 120
+    states, next_states = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    actions, rewards = rng.integers(2, size=n), rng.normal(size=n)
+    data = _Transitions(states, actions, rewards, next_states, rng.random(n) < 0.2)
+    fitted_on = rng.normal(size=n)
+    q = _QFunction.fit(regressor, data, fitted_on, 2, rng, None, 0)
+    discounts = np.where(data.terminated, 0.0, 0.9)
+    # on the targets the trees were fitted on, a backup is the fitted Q-function's own
+    np.testing.assert_allclose(q.backups(data, fitted_on, discounts, 1),
+                               rewards + discounts * q.values(next_states).max(axis=1))
+    # on others, the brute-force leaf means; leaves without data leave each tree's mean
+    data = data[:80]  # the last 40 transitions' leaves may now hold none
+    targets = rng.normal(size=80)
+    once = _brute_force_backup(q, data, targets, discounts[:80])
+    np.testing.assert_allclose(q.backups(data, targets, discounts[:80], 1), once)
+    np.testing.assert_allclose(q.backups(data, targets, discounts[:80], 2),
+                               _brute_force_backup(q, data, once, discounts[:80]))
+    only_zero = data[data.actions == 0]  # action 1's trees keep their own predictions
+    np.testing.assert_allclose(q.backups(only_zero, only_zero.rewards, 0.9, 1),
+                               _brute_force_backup(q, only_zero, only_zero.rewards, 0.9))
+
+
+def test_leaf_backups_carry_value_further_per_fit():
+    """A chain where only the last step pays: on trees that tell its states apart, each
+    leaf backup carries the value one more step back."""
+    n = 600
+    chain = np.tile(np.arange(6.0), n // 6)
+    states = np.column_stack([chain, np.zeros((n, 3))])
+    data = _Transitions(states, np.zeros(n, dtype=int), (chain == 5).astype(float),
+                        states + [1, 0, 0, 0], chain == 5, next_values=np.zeros(n))
+    tree = DecisionTreeRegressor()
+    agent = cartpole_agent(leaf_backups=3, gamma=0.5)
+    agent.n_actions = 1
+    agent._q = _QFunction.fit(tree, data, chain, 1, np.random.default_rng(0), None, 0)
+    targets = agent._targets(data)  # r (Q_{n-1} = 0 on the next states), then 3 backups
+    assert targets[:6].tolist() == [0.0, 0.0, 0.125, 0.25, 0.5, 1.0]
+    agent.leaf_backups, data.next_values = 0, np.zeros(n)
+    assert agent._targets(data)[:6].tolist() == [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+
+
+@pytest.mark.parametrize("regressor, error, match", [
+    (Ridge(), TypeError, "apply"),
+    (RandomForestRegressor(n_estimators=3), ValueError, "mean over its trees"),
+    (ExtraTreesRegressor(n_estimators=3, bootstrap=True), ValueError, "without bootstrap")])
+def test_leaf_backups_need_a_forest_of_leaf_means(regressor, error, match):
+    with pytest.raises(error, match=match):
+        FQI(regressor, "CartPole-v1", leaf_backups=2, n_envs=20)
+    with pytest.raises(ValueError, match="leaf_backups must be >= 0"):
+        cartpole_agent(leaf_backups=-1)
+
+
+def test_leaf_backups_learn_end_to_end():
+    obs = np.random.default_rng(0).normal(size=(50, 4))
+    for regressor in (ExtraTreesRegressor(n_estimators=5, random_state=0),
+                      BoxExtraTreesRegressor(n_estimators=5, bootstrap=False, n_jobs=1)):
+        with_backups, without = (
+            FQI(regressor, "CartPole-v1", n_envs=2, samples_per_iteration=300,
+                leaf_backups=backups, eval_episodes=0, seed=0).learn(total_timesteps=900)
+            for backups in (5, 0))
+        assert with_backups.iteration == 15  # 3 rounds of 5 backups
+        # the same data (the first round is random play), other targets from the second fit
+        first = with_backups.history[0]["collect_reward_per_step"]
+        assert first == without.history[0]["collect_reward_per_step"]
+        assert not np.allclose(with_backups.q_values(obs), without.q_values(obs))
 
 
 def test_exploration_falls_as_in_stable_baselines3s_dqn():
