@@ -127,13 +127,14 @@ class FQI:
         goal (``docs/fqi.md``). `predict` stays deterministic: the lowest tied action.
     leaf_backups : int, default=0
         Fitted-Q backups before each fit that keep ``Q_{n-1}``'s trees and recompute only
-        their leaves' values, as means of the current targets (a frozen-structure
-        Extra-Trees, Ernst et al., 2005): value then travels ``leaf_backups + 1`` steps per
-        fit instead of one, each extra backup for about the cost of a prediction. Needs a
-        forest with ``apply`` that predicts the mean of its trees' leaf means, checked here:
-        scikit-learn's ``ExtraTreesRegressor``, or `boxtrees.BoxExtraTreesRegressor` with
-        ``bootstrap=False`` (a bootstrap sample weighs the leaf means). Memory: one leaf id
-        per transition and tree, and per next state, tree and action.
+        their leaves' values, as means of the current targets (the frozen-structure
+        Extra-Trees of "Tree-Based Batch Mode Reinforcement Learning", 2005): value travels
+        ``leaf_backups + 1`` steps per fit instead of one, each extra backup for about the
+        cost of a prediction. Needs a forest with ``apply`` that predicts the mean of its
+        trees' leaf means, checked here: scikit-learn's ``ExtraTreesRegressor``, or
+        `boxtrees.BoxExtraTreesRegressor` with ``bootstrap=False`` (a bootstrap sample
+        weighs the leaf means). Memory: one leaf id per transition and tree, and per next
+        state, tree and action.
     n_envs : int, default=None
         Envs played side by side while collecting; None: the vector env's own number, or
         16 for any other env form.
