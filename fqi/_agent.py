@@ -346,8 +346,9 @@ class FQI:
         self._data = None
 
     def _check_regressor(self, observations, batch):
-        """Fit a clone of the regressor on `batch` (zero targets) and check its predictions,
-        so that a regressor that cannot take these observations fails now."""
+        """Fit a clone of the regressor on `batch` (zero targets; distinct ones with
+        `leaf_backups`, whose leaf means are checked too) and check its predictions, so that
+        a regressor that cannot take these observations fails now."""
         model = clone(self.regressor)
         # distinct targets when the leaves' means are checked (leaf_backups), else zeros
         y = np.arange(len(batch), dtype=float) * self.leaf_backups

@@ -6,7 +6,7 @@ import joblib
 
 __all__ = []
 
-_SAVE_FORMAT = 4  # 3: the exploration schedule replaced epsilon; 4: tie_break
+_SAVE_FORMAT = 5  # 3: the exploration schedule replaced epsilon; 4: tie_break; 5: leaf_backups
 
 
 def _write_save(state, path):
