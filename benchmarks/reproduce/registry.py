@@ -675,6 +675,35 @@ def _games(name, env_id, env_kwargs, steps, eval_every, max_objects, fqi, dqn, p
 
 EXPERIMENTS += tuple(_games(name, *spec) for name, spec in _GAMES.items())
 
+# The baselines' short tuning on a real game's objects, as the searches above for the
+# thesis's game: a quarter of a run's steps, from rl-zoo3's Atari settings, which are made
+# for 10 million steps of pixels. One hypothesis per setting.
+_GAME_SEARCH_STEPS = 125_000
+_GAME_SEARCH = {
+    # the zoo's DQN fills its buffer for 100,000 steps, after its exploration is over (10 %
+    # of 500,000); starting at 1 % of the budget, as the zoo does of its 10 million
+    "DQN, rl-zoo3 Atari": ("DQN", ATARI_DQN),
+    "DQN, rl-zoo3 Atari, learning starts 5,000": ("DQN", {**ATARI_DQN,
+                                                           "learning_starts": 5_000}),
+    "DQN, rl-zoo3 Atari, learning starts 5,000, lr 5e-4": (
+        "DQN", {**ATARI_DQN, "learning_starts": 5_000, "learning_rate": 5e-4}),
+    "DQN, rl-zoo3 LunarLander (gamma 0.99, a gradient step every 4)": ("DQN", SMALL_TASK_DQN),
+    "PPO, rl-zoo3 Atari": ("PPO", ATARI_PPO),
+    "PPO, rl-zoo3 Atari, gamma 0.9": ("PPO", {**ATARI_PPO, "gamma": 0.9}),
+    "PPO, rl-zoo3 Atari, no entropy bonus": ("PPO", {**ATARI_PPO, "ent_coef": 0.0}),
+    "PPO, rl-zoo3 LunarLander (gamma 0.99)": ("PPO", _ZOO_PPO),
+}
+EXPERIMENTS += (Experiment(
+    "search_games_boxing", "extra", "Search: DQN and PPO on Boxing's objects", "games",
+    env_id="AtariObjects-v0", on_demand=True, seeds=1,
+    defaults={"env_kwargs": {"game": "Boxing"}, "eval_every": 25_000, "max_objects": 8,
+              "steps": _GAME_SEARCH_STEPS},
+    settings={label: {"learner": algo, "hyperparams": config}
+              for label, (algo, config) in _GAME_SEARCH.items()},
+    notes="A quarter of games_boxing's 500,000 steps, one seed, scored as there (5 held-out "
+          "episodes every 25,000 steps); settings named by the rl-zoo3 entry they start "
+          "from."),)
+
 REGISTRY = {experiment.name: experiment for experiment in EXPERIMENTS}
 
 

@@ -20,7 +20,7 @@ def test_registry_covers_every_thesis_figure_once():
         "keep_data", "keep_data_horizon", "dqn", "attention", "ceiling", "ceiling_sword",
         "baselines", "search_dqn_grid", "search_dqn_objects", "search_ppo_objects", "control_cartpole",
         "control_acrobot", "control_mountaincar", "control_lunarlander", "fqi_defaults",
-        "games_pong", "games_freeway", "games_boxing", "games_highway"}
+        "games_pong", "games_freeway", "games_boxing", "games_highway", "search_games_boxing"}
     ablations = [e for e in EXPERIMENTS if e.explains]
     assert {name for e in ablations for name in e.explains} == {
         "rmse_K", "rmse_nmin", "rmse_TW", "rmse_grid", "fqi_grid", "representations",
@@ -31,7 +31,7 @@ def test_registry_covers_every_thesis_figure_once():
     assert {e.name for e in EXPERIMENTS if e.on_demand} == {
         "keep_data_horizon", "search_dqn_grid", "search_dqn_objects", "search_ppo_objects", "control_cartpole",
         "control_acrobot", "control_mountaincar", "control_lunarlander", "fqi_defaults",
-        "games_pong", "games_freeway", "games_boxing", "games_highway"}
+        "games_pong", "games_freeway", "games_boxing", "games_highway", "search_games_boxing"}
     assert len(REGISTRY) == len(EXPERIMENTS)
 
 
