@@ -40,6 +40,10 @@ class SetEncoder(BaseFeaturesExtractor):
         Add one masked self-attention layer between the object MLP and the pooling.
     n_heads : int, default=4
         Heads of the attention layer (must divide ``embed_dim``).
+    scale : array-like of shape (d,), default=None
+        Each attribute's scale, positive and finite, instead of the one read from the
+        bounds: for spaces whose bounds are far wider than the values the game takes
+        (divided by a loose bound, small moves become too small for the MLP to tell apart).
 
     Examples
     --------
@@ -55,7 +59,8 @@ class SetEncoder(BaseFeaturesExtractor):
     """
 
     def __init__(self, observation_space: spaces.Box, embed_dim: int = 64,
-                 features_dim: int = 128, attention: bool = False, n_heads: int = 4) -> None:
+                 features_dim: int = 128, attention: bool = False, n_heads: int = 4,
+                 scale=None) -> None:
         if not (isinstance(observation_space, spaces.Box) and len(observation_space.shape) == 2
                 and observation_space.shape[1] >= 3):
             raise ValueError(f"SetEncoder needs a Box observation space of shape (max_objects, "
@@ -76,8 +81,11 @@ class SetEncoder(BaseFeaturesExtractor):
                              f"{high[d]} in {observation_space}")
         super().__init__(observation_space, features_dim)
         self.n_attributes, self.n_types = d, int(high[d]) + 1
-        bounds = np.max(np.abs([low[:d], high[:d]]), axis=0).astype(np.float64)
-        scale = np.where(np.isfinite(bounds) & (bounds > 0), bounds, 1.0)
+        if scale is None:
+            bounds = np.max(np.abs([low[:d], high[:d]]), axis=0).astype(np.float64)
+            scale = np.where(np.isfinite(bounds) & (bounds > 0), bounds, 1.0)
+        else:
+            scale = _check_scale(scale, d)
         self.register_buffer("scale", torch.as_tensor(scale, dtype=torch.float32),
                              persistent=False)
         self.objects = nn.Sequential(nn.Linear(d + self.n_types, embed_dim), nn.ReLU(),
@@ -105,3 +113,17 @@ class SetEncoder(BaseFeaturesExtractor):
         largest = torch.where(mask, hidden, -torch.inf).amax(dim=1)
         largest = torch.where(valid.any(dim=1, keepdim=True), largest, 0.0)
         return self.head(torch.cat([mean, largest], dim=-1))
+
+
+def _check_scale(scale, d):
+    """`scale` as ``d`` positive finite floats, or a ValueError naming what is wrong."""
+    try:
+        values = np.asarray(scale, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"scale must be an array-like of {d} numbers, got {scale!r}") from None
+    if values.shape != (d,):
+        raise ValueError(f"scale must have one value per attribute, shape ({d},), got shape "
+                         f"{values.shape}")
+    if not (np.isfinite(values).all() and (values > 0).all()):
+        raise ValueError(f"scale must be positive and finite, got {values}")
+    return values

@@ -61,9 +61,27 @@ def test_the_encoder_trains_with_dqn_and_ppo(algorithm):
     assert env.action_space.contains(int(action))
 
 
+def test_a_given_scale_divides_the_attributes_in_place_of_the_bounds():
+    env = padded_env()
+    obs = torch.as_tensor(observations(env))
+    torch.manual_seed(0)
+    by_bounds = SetEncoder(env.observation_space, embed_dim=16, features_dim=8)
+    torch.manual_seed(0)
+    given = SetEncoder(env.observation_space, embed_dim=16, features_dim=8,
+                       scale=[2.0, 0.5])
+    np.testing.assert_allclose(given.scale, [2.0, 0.5])
+    rescaled = obs.clone()  # the same attributes over the given scale as over the bounds'
+    rescaled[..., :2] *= torch.tensor([2.0, 0.5]) / by_bounds.scale
+    with torch.no_grad():
+        np.testing.assert_allclose(given(rescaled), by_bounds(obs), atol=1e-5)
+
+
 @pytest.mark.parametrize("kwargs, match", [
     (dict(embed_dim=0), "embed_dim"), (dict(features_dim=2.5), "features_dim"),
     (dict(attention=True, embed_dim=10, n_heads=4), "must divide"),
+    (dict(scale=[1.0]), r"one value per attribute, shape \(2,\)"),
+    (dict(scale=[1.0, 0.0]), "positive and finite"),
+    (dict(scale=[1.0, np.nan]), "positive and finite"),
 ])
 def test_bad_parameters_are_rejected(kwargs, match):
     with pytest.raises(ValueError, match=match):
@@ -78,3 +96,5 @@ def test_an_unbounded_type_column_or_a_non_bool_attention_is_rejected():
         SetEncoder(gym.spaces.Box(-high, high))
     with pytest.raises(TypeError, match="attention must be a bool"):
         SetEncoder(padded_env().observation_space, attention=1)
+    with pytest.raises(TypeError, match="scale must be an array-like of 2 numbers"):
+        SetEncoder(padded_env().observation_space, scale=["near", "far"])

@@ -679,6 +679,16 @@ EXPERIMENTS += tuple(_games(name, *spec) for name, spec in _GAMES.items())
 # thesis's game: a quarter of a run's steps, from rl-zoo3's Atari settings, which are made
 # for 10 million steps of pixels. One hypothesis per setting.
 _GAME_SEARCH_STEPS = 125_000
+_BOXING_RANGE = [75.0, 81.0, 14.0, 46.0, 5.0, 9.0]  # x, y, w, h, dx, dy
+
+
+def _scaled(hyperparams, scale):
+    """`hyperparams` whose `fqi.SetEncoder` divides the attributes by `scale`."""
+    policy_kwargs = hyperparams.get("policy_kwargs", {})
+    return {**hyperparams, "policy_kwargs": {**policy_kwargs, "features_extractor_kwargs": {
+        **policy_kwargs.get("features_extractor_kwargs", {}), "scale": scale}}}
+
+
 _GAME_SEARCH = {
     # the zoo's DQN fills its buffer for 100,000 steps, after its exploration is over (10 %
     # of 500,000); starting at 1 % of the budget, as the zoo does of its 10 million
@@ -692,6 +702,17 @@ _GAME_SEARCH = {
     "PPO, rl-zoo3 Atari, gamma 0.9": ("PPO", {**ATARI_PPO, "gamma": 0.9}),
     "PPO, rl-zoo3 Atari, no entropy bonus": ("PPO", {**ATARI_PPO, "ent_coef": 0.0}),
     "PPO, rl-zoo3 LunarLander (gamma 0.99)": ("PPO", _ZOO_PPO),
+    # then: the encoder divides each attribute by its space's bound, 512, where Boxing's
+    # values stay within about 80 (a move of 4 pixels is 0.008); here by the largest
+    # absolute value of each attribute in two episodes of random play
+    **{f"{label}, attributes over their random-play range": (algo, _scaled(config, _BOXING_RANGE))
+       for label, (algo, config) in (
+           ("DQN, rl-zoo3 Atari, learning starts 5,000", ("DQN", {**ATARI_DQN,
+                                                                   "learning_starts": 5_000})),
+           ("DQN, rl-zoo3 Atari, learning starts 5,000, lr 5e-4", (
+               "DQN", {**ATARI_DQN, "learning_starts": 5_000, "learning_rate": 5e-4})),
+           ("PPO, rl-zoo3 Atari", ("PPO", ATARI_PPO)),
+           ("PPO, rl-zoo3 Atari, gamma 0.9", ("PPO", {**ATARI_PPO, "gamma": 0.9})))},
 }
 EXPERIMENTS += (Experiment(
     "search_games_boxing", "extra", "Search: DQN and PPO on Boxing's objects", "games",

@@ -93,6 +93,21 @@ def test_a_ppo_run_on_the_objects_with_attention(normalize, gamma, monkeypatch):
     assert all(env.ret_rms.count >= TINY.dqn_steps for _, env in wrapped)
 
 
+def test_the_set_encoders_arguments_pass_through_the_hyperparameters():
+    pytest.importorskip("torch")
+    from benchmarks.reproduce.kinds.sb3 import with_set_encoder
+    from fqi import SetEncoder
+
+    given = {"gamma": 0.9, "policy_kwargs": {"net_arch": [8],
+                                             "features_extractor_kwargs": {"scale": [2, 3]}}}
+    assert with_set_encoder(given, attention=True) == {
+        "gamma": 0.9, "policy_kwargs": {
+            "net_arch": [8], "features_extractor_class": SetEncoder,
+            "features_extractor_kwargs": {"scale": [2, 3], "attention": True}}}
+    assert with_set_encoder({})["policy_kwargs"]["features_extractor_kwargs"] == {
+        "attention": False}
+
+
 def test_reference_policies_score_on_the_reference_worlds_as_learners_do():
     from benchmarks.reproduce.units import run_unit
     from fqi import evaluate

@@ -60,12 +60,14 @@ class TunedBaselineSettings(GameSettings):
 
 def with_set_encoder(hyperparams, attention=False):
     """stable-baselines3 `hyperparams` whose policy reads padded objects through
-    `fqi.SetEncoder` (with `attention`)."""
+    `fqi.SetEncoder` (with `attention`, and the encoder's other arguments that
+    ``policy_kwargs["features_extractor_kwargs"]`` holds)."""
     from fqi import SetEncoder  # imports torch: only here
 
-    policy_kwargs = {**hyperparams.get("policy_kwargs", {}),
-                     "features_extractor_class": SetEncoder,
-                     "features_extractor_kwargs": {"attention": attention}}
+    given = hyperparams.get("policy_kwargs", {})
+    policy_kwargs = {**given, "features_extractor_class": SetEncoder,
+                     "features_extractor_kwargs": {**given.get("features_extractor_kwargs", {}),
+                                                   "attention": attention}}
     return {**hyperparams, "policy_kwargs": policy_kwargs}
 
 
