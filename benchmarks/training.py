@@ -203,12 +203,15 @@ class WrappedPolicy:
     model : object
         Has ``predict(batch, deterministic=True)``.
     wrapper : gymnasium.ObservationWrapper
+    sampled : bool, default=False
+        Always play the model's non-deterministic actions (as rl-zoo3 plays Atari games),
+        even when asked for greedy ones.
     """
 
-    def __init__(self, model, wrapper):
-        self.model, self.wrapper = model, wrapper
+    def __init__(self, model, wrapper, sampled=False):
+        self.model, self.wrapper, self.sampled = model, wrapper, sampled
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         batch = np.stack([self.wrapper.observation(observation[i])
                           for i in range(len(observation))])
-        return self.model.predict(batch, deterministic=deterministic)[0], None
+        return self.model.predict(batch, deterministic=deterministic and not self.sampled)[0], None

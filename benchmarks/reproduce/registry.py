@@ -689,38 +689,44 @@ def _scaled(hyperparams, scale):
         **policy_kwargs.get("features_extractor_kwargs", {}), "scale": scale}}}
 
 
-_GAME_SEARCH = {
+_DQN_STARTS_EARLY = {**ATARI_DQN, "learning_starts": 5_000}
+_DQN_STARTS_EARLY_LR = {**_DQN_STARTS_EARLY, "learning_rate": 5e-4}
+_PPO_GAMMA_09 = {**ATARI_PPO, "gamma": 0.9}
+_GAME_SEARCH = {  # label -> (learner, hyperparams)
     # the zoo's DQN fills its buffer for 100,000 steps, after its exploration is over (10 %
     # of 500,000); starting at 1 % of the budget, as the zoo does of its 10 million
     "DQN, rl-zoo3 Atari": ("DQN", ATARI_DQN),
-    "DQN, rl-zoo3 Atari, learning starts 5,000": ("DQN", {**ATARI_DQN,
-                                                           "learning_starts": 5_000}),
-    "DQN, rl-zoo3 Atari, learning starts 5,000, lr 5e-4": (
-        "DQN", {**ATARI_DQN, "learning_starts": 5_000, "learning_rate": 5e-4}),
+    "DQN, rl-zoo3 Atari, learning starts 5,000": ("DQN", _DQN_STARTS_EARLY),
+    "DQN, rl-zoo3 Atari, learning starts 5,000, lr 5e-4": ("DQN", _DQN_STARTS_EARLY_LR),
     "DQN, rl-zoo3 LunarLander (gamma 0.99, a gradient step every 4)": ("DQN", SMALL_TASK_DQN),
     "PPO, rl-zoo3 Atari": ("PPO", ATARI_PPO),
-    "PPO, rl-zoo3 Atari, gamma 0.9": ("PPO", {**ATARI_PPO, "gamma": 0.9}),
+    "PPO, rl-zoo3 Atari, gamma 0.9": ("PPO", _PPO_GAMMA_09),
     "PPO, rl-zoo3 Atari, no entropy bonus": ("PPO", {**ATARI_PPO, "ent_coef": 0.0}),
     "PPO, rl-zoo3 LunarLander (gamma 0.99)": ("PPO", _ZOO_PPO),
-    # then: the encoder divides each attribute by its space's bound, 512, where Boxing's
-    # values stay within about 80 (a move of 4 pixels is 0.008); here by the largest
-    # absolute value of each attribute in two episodes of random play
-    **{f"{label}, attributes over their random-play range": (algo, _scaled(config, _BOXING_RANGE))
-       for label, (algo, config) in (
-           ("DQN, rl-zoo3 Atari, learning starts 5,000", ("DQN", {**ATARI_DQN,
-                                                                   "learning_starts": 5_000})),
-           ("DQN, rl-zoo3 Atari, learning starts 5,000, lr 5e-4", (
-               "DQN", {**ATARI_DQN, "learning_starts": 5_000, "learning_rate": 5e-4})),
-           ("PPO, rl-zoo3 Atari", ("PPO", ATARI_PPO)),
-           ("PPO, rl-zoo3 Atari, gamma 0.9", ("PPO", {**ATARI_PPO, "gamma": 0.9})))},
 }
+# then: the encoder divides each attribute by its space's bound, 512, where Boxing's values
+# stay within about 80 (a move of 4 pixels is 0.008); here by the largest absolute value of
+# each attribute in two episodes of random play
+_GAME_SEARCH.update({
+    f"{label}, attributes over their random-play range": (learner, _scaled(config,
+                                                                           _BOXING_RANGE))
+    for label, (learner, config) in _GAME_SEARCH.items()
+    if label in ("DQN, rl-zoo3 Atari, learning starts 5,000",
+                 "DQN, rl-zoo3 Atari, learning starts 5,000, lr 5e-4", "PPO, rl-zoo3 Atari",
+                 "PPO, rl-zoo3 Atari, gamma 0.9")})
+_GAME_SEARCH_SETTINGS = {label: {"learner": learner, "hyperparams": config}
+                         for label, (learner, config) in _GAME_SEARCH.items()}
+# then: the greedy policies play one action whatever the enemy does (each score repeats
+# from one evaluation to the next); rl-zoo3 plays Atari games with sampled actions
+_GAME_SEARCH_SETTINGS.update({
+    f"{label}, sampled actions": {**_GAME_SEARCH_SETTINGS[label], "sampled_actions": True}
+    for label in ("PPO, rl-zoo3 Atari", "PPO, rl-zoo3 Atari, gamma 0.9")})
 EXPERIMENTS += (Experiment(
     "search_games_boxing", "extra", "Search: DQN and PPO on Boxing's objects", "games",
     env_id="AtariObjects-v0", on_demand=True, seeds=1,
     defaults={"env_kwargs": {"game": "Boxing"}, "eval_every": 25_000, "max_objects": 8,
               "steps": _GAME_SEARCH_STEPS},
-    settings={label: {"learner": algo, "hyperparams": config}
-              for label, (algo, config) in _GAME_SEARCH.items()},
+    settings=_GAME_SEARCH_SETTINGS,
     notes="A quarter of games_boxing's 500,000 steps, one seed, scored as there (5 held-out "
           "episodes every 25,000 steps); settings named by the rl-zoo3 entry they start "
           "from."),)

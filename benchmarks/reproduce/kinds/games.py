@@ -100,8 +100,10 @@ class GamesSettings:
     "DQN", "PPO", "random" or "scripted") and ``steps`` (environment steps at full size,
     for the learners); for FQI ``forest`` (`boxtrees.BoxExtraTreesRegressor` arguments)
     and ``fqi`` (`fqi.FQI` arguments other than its defaults); for SB3 ``hyperparams``
-    (rl-zoo3's form, `training.train_sb3`) and ``max_objects`` (the padded rows); the
-    evaluation: ``eval_episodes`` held-out episodes every ``eval_every`` steps."""
+    (rl-zoo3's form, `training.train_sb3`), ``max_objects`` (the padded rows) and
+    ``sampled_actions`` (the evaluations play actions drawn from the policy, as rl-zoo3
+    plays Atari games, instead of the greedy ones); the evaluation: ``eval_episodes``
+    held-out episodes every ``eval_every`` steps."""
 
     env_id: str
     learner: str = None
@@ -111,6 +113,7 @@ class GamesSettings:
     fqi: dict = field(default_factory=dict)
     hyperparams: dict = field(default_factory=dict)
     max_objects: int = 32
+    sampled_actions: bool = False
     eval_every: int = 50_000
     eval_episodes: int = 5
 
@@ -122,6 +125,9 @@ class GamesSettings:
         if self.learner == "scripted" and self.game not in _SCRIPTS:
             raise ValueError(f"no scripted policy for {self.game!r} (scripts: "
                              f"{', '.join(_SCRIPTS)})")
+        if self.sampled_actions and self.learner not in ("DQN", "PPO"):
+            raise ValueError(f"sampled_actions is for the DQN and PPO learners, not "
+                             f"{self.learner!r}")
         learns = self.learner in ("fqi", "DQN", "PPO")
         if learns and not (isinstance(self.steps, int) and self.steps >= 1):
             raise ValueError(f"steps must be a whole number >= 1, got {self.steps!r}")
@@ -186,7 +192,8 @@ class Games(Control):
                                                       * budget.control_scale)),
                              n_episodes=settings.eval_episodes,
                              policy=(None if settings.learner == "fqi"
-                                     else lambda model: WrappedPolicy(model, padded)))
+                                     else lambda model: WrappedPolicy(
+                                         model, padded, sampled=settings.sampled_actions)))
         if settings.learner == "fqi":
             agent = FQI(BoxExtraTreesRegressor(**settings.forest), env, eval_episodes=0,
                         seed=unit.seed, **settings.fqi)
