@@ -56,3 +56,6 @@ def test_the_games_experiments_and_their_budgets():
         kind.settings({"env_id": "AtariObjects-v0", "learner": "random"})
     with pytest.raises(ValueError, match="steps must be"):
         kind.settings({"env_id": "highway-fast-v0", "learner": "fqi"})
+    with pytest.raises(ValueError, match="sampled_actions is for the DQN and PPO learners"):
+        kind.settings({"env_id": "highway-fast-v0", "learner": "fqi", "steps": 10,
+                       "sampled_actions": True})

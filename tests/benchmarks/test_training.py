@@ -47,6 +47,23 @@ def test_a_model_trained_on_wrapped_observations_plays_from_the_envs_own():
     np.testing.assert_array_equal(played.returns, wrapped.returns)
 
 
+def test_a_wrapped_policy_plays_sampled_actions_when_asked_to_whatever_it_is_asked():
+    class Recorder:
+        asked = []
+
+        def predict(self, batch, deterministic=True):
+            self.asked.append(deterministic)
+            return np.zeros(len(batch), dtype=int), None
+
+    env = gym.make("ObjectWorld-v0")
+    grid, model = GridObservation(env, n_bins=4), Recorder()
+    batch = [env.reset(seed=0)[0]] * 2
+    WrappedPolicy(model, grid).predict(batch, deterministic=True)
+    WrappedPolicy(model, grid).predict(batch, deterministic=False)
+    WrappedPolicy(model, grid, sampled=True).predict(batch, deterministic=True)
+    assert model.asked == [True, False, False]
+
+
 @pytest.mark.parametrize("kwargs, match", [({"eval_freq": 0}, "eval_freq must be > 0"),
                                             ({"score": "median"}, "score must be")])
 def test_bad_evaluation_settings(kwargs, match):
