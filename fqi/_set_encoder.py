@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 import torch
 from gymnasium import spaces
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
@@ -60,7 +61,7 @@ class SetEncoder(BaseFeaturesExtractor):
 
     def __init__(self, observation_space: spaces.Box, embed_dim: int = 64,
                  features_dim: int = 128, attention: bool = False, n_heads: int = 4,
-                 scale=None) -> None:
+                 scale: npt.ArrayLike | None = None) -> None:
         if not (isinstance(observation_space, spaces.Box) and len(observation_space.shape) == 2
                 and observation_space.shape[1] >= 3):
             raise ValueError(f"SetEncoder needs a Box observation space of shape (max_objects, "
@@ -115,7 +116,7 @@ class SetEncoder(BaseFeaturesExtractor):
         return self.head(torch.cat([mean, largest], dim=-1))
 
 
-def _check_scale(scale, d):
+def _check_scale(scale: npt.ArrayLike, d: int) -> np.ndarray:
     """`scale` as ``d`` positive finite floats, or a ValueError naming what is wrong."""
     try:
         values = np.asarray(scale, dtype=np.float64)
