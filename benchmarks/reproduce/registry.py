@@ -677,7 +677,6 @@ def _games(name, env_id, env_kwargs, steps, eval_every, max_objects, fqi, dqn, p
               f"core per run.")
 
 
-
 # The baselines' short tuning on a real game's objects, as the searches above for the
 # thesis's game: a quarter of a run's steps, from rl-zoo3's Atari settings, which are made
 # for 10 million steps of pixels. One hypothesis per setting.
@@ -694,7 +693,6 @@ def _scaled(hyperparams, scale):
 
 _DQN_STARTS_EARLY = {**ATARI_DQN, "learning_starts": 5_000}
 _DQN_STARTS_EARLY_LR = {**_DQN_STARTS_EARLY, "learning_rate": 5e-4}
-_PPO_GAMMA_09 = {**ATARI_PPO, "gamma": 0.9}
 _GAME_SEARCH = {  # label -> (learner, hyperparams)
     # the zoo's DQN fills its buffer for 100,000 steps, after its exploration is over (10 %
     # of 500,000); starting at 1 % of the budget, as the zoo does of its 10 million
@@ -703,7 +701,7 @@ _GAME_SEARCH = {  # label -> (learner, hyperparams)
     "DQN, rl-zoo3 Atari, learning starts 5,000, lr 5e-4": ("DQN", _DQN_STARTS_EARLY_LR),
     "DQN, rl-zoo3 LunarLander (gamma 0.99, a gradient step every 4)": ("DQN", SMALL_TASK_DQN),
     "PPO, rl-zoo3 Atari": ("PPO", ATARI_PPO),
-    "PPO, rl-zoo3 Atari, gamma 0.9": ("PPO", _PPO_GAMMA_09),
+    "PPO, rl-zoo3 Atari, gamma 0.9": ("PPO", {**ATARI_PPO, "gamma": 0.9}),
     "PPO, rl-zoo3 Atari, no entropy bonus": ("PPO", {**ATARI_PPO, "ent_coef": 0.0}),
     "PPO, rl-zoo3 LunarLander (gamma 0.99)": ("PPO", _ZOO_PPO),
 }
