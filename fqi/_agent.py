@@ -36,8 +36,9 @@ _TIE_BREAKS = ("random", "first")
 _TIE_TOLERANCE = 1e-6  # relative: Q-values closer than this to the best tie with it
 # What `save` leaves out (SB3 saves its __dict__ minus such a list): the envs, which hold
 # simulators, the transitions, the threads and the logs.
-_UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_data", "_csv_log",
+_UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_held", "_data", "_csv_log",
                       "_logger"})
+_MAX_HOLD = 10_000  # steps: the cap on the duration of a held exploratory action
 # What a save holds beyond the constructor parameters.
 _LEARNED = ("_q", "history", "num_timesteps", "iteration", "observation_space",
             "action_space")
@@ -63,7 +64,8 @@ class FQI:
     1. *collect* (iteration 0, then every `resample_every` iterations):
        `samples_per_iteration` transitions from the `n_envs` envs of a gymnasium vector env,
        with the uniform random policy at iteration 0 and the epsilon-greedy policy of
-       ``Q_{n-1}`` later, epsilon falling as in stable-baselines3's DQN. With `keep_data`
+       ``Q_{n-1}`` later, epsilon falling as in stable-baselines3's DQN (with
+       `exploration_zeta`, each random action is held for a random number of steps). With `keep_data`
        they are appended to the data set (oldest dropped beyond `max_samples`), else they
        replace it;
     2. *targets*: ``r`` at iteration 0, then ``r + gamma * max_a Q_{n-1}(s', a)`` for every
@@ -117,6 +119,18 @@ class FQI:
         Probability of a uniform random action while collecting, at the start and at the end
         of the schedule (the thesis: 0.2 throughout). The first round plays uniformly at
         random whatever they are: there is no Q-function yet.
+    exploration_zeta : float or None, default=None
+        None: each random action lasts one step (epsilon-greedy). A number ``mu > 1``:
+        temporally-extended epsilon-greedy ("ez-greedy", Dabney, Ostrovski and Barreto,
+        2021): an env that is not holding an action starts, with the probability of a random
+        action, to hold a uniformly drawn action for ``n`` steps, ``n`` drawn from the zeta
+        distribution of exponent ``mu`` (``P(n) ~ n**-mu``: mostly short, sometimes long;
+        capped at 10,000 steps; a hold may run on into the env's next episode), and acts
+        greedily otherwise; the first round holds random actions the same way. Random play
+        that repeats its actions travels far (its displacement grows with the hold
+        durations), where one-step random play dithers in place: the remedy for a sparse
+        reward far from the start (Atari's Freeway: ``docs/games.md``). 2 is the paper's
+        choice. `predict` with ``deterministic=False`` stays one-step epsilon-greedy.
     tie_break : {"random", "first"}, default="random"
         How the collection's greedy action is chosen among tied ones (Q-values within a
         relative ``1e-6`` of the best): "random" draws one uniformly, "first" takes the
@@ -214,13 +228,15 @@ class FQI:
     action_space: spaces.Discrete
     n_actions: int
     _collector: _Collector | None
+    _held: np.ndarray | None
     _logger: Logger | None
 
     def __init__(self, regressor: Regressor, env: EnvLike, gamma: float = 0.99,
                  samples_per_iteration: int = 2_500, resample_every: int | None = 5,
                  keep_data: bool = True, max_samples: int = 100_000,
                  exploration_fraction: float = 0.1, exploration_initial_eps: float = 1.0,
-                 exploration_final_eps: float = 0.05, tie_break: str = "random",
+                 exploration_final_eps: float = 0.05,
+                 exploration_zeta: float | None = None, tie_break: str = "random",
                  leaf_backups: int = 0, n_envs: int | None = None,
                  eval_episodes: int | None = None, eval_seeds: Sequence[int] | None = None,
                  eval_env: EnvLike | None = None, n_jobs: int = 1,
@@ -265,6 +281,13 @@ class FQI:
                                                    params["exploration_initial_eps"], 0.0, 1.0)
         self.exploration_final_eps = _check_real("exploration_final_eps",
                                                  params["exploration_final_eps"], 0.0, 1.0)
+        zeta = params["exploration_zeta"]
+        if zeta is not None:
+            zeta = _check_real("exploration_zeta", zeta, 1.0, np.inf)
+            if zeta == 1.0:
+                raise ValueError("exploration_zeta must be greater than 1 (the zeta "
+                                 "distribution's exponent), or None, got 1.0")
+        self.exploration_zeta = zeta
         self.tie_break = _check_choice("tie_break", params["tie_break"], _TIE_BREAKS)
         self.leaf_backups = _check_int("leaf_backups", params["leaf_backups"], 0)
         if self.leaf_backups and not callable(getattr(regressor, "apply", None)):
@@ -342,7 +365,7 @@ class FQI:
         self._env, self._eval_env = vector, eval_vector
         self.observation_space, self.action_space = observation_space, action_space
         self.n_actions, self._observations = n_actions, observations
-        self._collector = None
+        self._collector = self._held = None
         self._data = None
 
     def _check_regressor(self, observations, batch):
@@ -459,6 +482,8 @@ class FQI:
                              "FQI.load or call set_env(env)")
         if self._collector is None:
             self._collector = _Collector(self._env, self._observations, self._world_rng)
+            # per env: the exploratory action held (exploration_zeta) and its steps left
+            self._held = np.zeros((2, self._env.num_envs), dtype=np.int64)
         return self._train(callback, progress_bar, total_timesteps, n_iterations)
 
     def learn_offline(self, dataset: Dataset, n_iterations: int,
@@ -634,12 +659,29 @@ class FQI:
         return self._data is None or (self.resample_every is not None
                                       and self.iteration % self.resample_every == 0)
 
-    def _behaviour(self, obs, q):
-        """Collection policy: uniform random before the first fit (``q`` is None), then
-        epsilon-greedy on the Q-values ``q`` of the observations."""
+    def _behaviour(self, obs, q, envs):
+        """Collection policy for the observations `obs` of the envs `envs` (indices):
+        uniform random before the first fit (``q`` is None), then epsilon-greedy on the
+        Q-values ``q`` of the observations; with `exploration_zeta`, random actions held."""
+        if self.exploration_zeta is not None:
+            return self._held_epsilon_greedy(q, envs)
         if q is None:
-            return self._action_rng.integers(self.n_actions, size=len(obs))
+            return self._action_rng.integers(self.n_actions, size=len(envs))
         return self._epsilon_greedy(q)
+
+    def _held_epsilon_greedy(self, q, envs):
+        """Temporally-extended epsilon-greedy actions of the envs `envs` (see
+        `exploration_zeta`); random play (probability 1) before the first fit."""
+        held, left = self._held
+        rng = self._action_rng
+        epsilon = 1.0 if q is None else self.exploration_rate
+        start = envs[(left[envs] == 0) & (rng.random(len(envs)) < epsilon)]
+        held[start] = rng.integers(self.n_actions, size=len(start))
+        left[start] = np.minimum(rng.zipf(self.exploration_zeta, size=len(start)), _MAX_HOLD)
+        holding = left[envs] > 0
+        actions = held[envs] if q is None else np.where(holding, held[envs], self._greedy(q))
+        left[envs[holding]] -= 1
+        return actions
 
     def _epsilon_greedy(self, q):
         n = len(q)
@@ -766,7 +808,8 @@ class FQI:
         agent = cls.__new__(cls)
         agent.__dict__.update({k: v for k, v in state.items() if k not in names})
         agent._set_params({**{name: state[name] for name in names}, **params})
-        agent._env = agent._eval_env = agent._collector = agent._data = agent._logger = None
+        agent._env = agent._eval_env = agent._collector = agent._held = None
+        agent._data = agent._logger = None
         env = agent.env if env is None else env
         if env is not None:
             agent.set_env(env)

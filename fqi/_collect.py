@@ -78,8 +78,9 @@ class _Collector:
         ----------
         n_samples : int
         policy : callable
-            ``policy(obs, q) -> actions`` for a batch of observations (the envs that play
-            this step) and their Q-values ``q`` (None without `q_values`).
+            ``policy(obs, q, envs) -> actions`` for a batch of observations, those of the
+            envs that play this step (``envs``: their indices), and their Q-values ``q``
+            (None without `q_values`).
         q_values : callable, default=None
             ``q_values(obs) -> (n, n_actions)`` array. In ``NEXT_STEP`` mode the Q-values of
             each step's observations serve twice: to act, and as the previous step's
@@ -110,9 +111,10 @@ class _Collector:
                 pending = None
             actions = np.zeros(n_envs, dtype=np.intp)
             if everyone:
-                actions[:] = policy(obs, q)
+                actions[:] = policy(obs, q, np.arange(n_envs))
             elif live.any():
-                actions[live] = policy(obs[live], None if q is None else q[live])
+                actions[live] = policy(obs[live], None if q is None else q[live],
+                                       np.flatnonzero(live))
             next_obs, rewards, terminated, truncated = self._step(actions)
             if live.any():
                 part = _Transitions(obs, actions, rewards, next_obs, terminated)

@@ -188,7 +188,8 @@ def test_training_never_sees_reference_worlds():
         return reset(seed=seed, options=options)
 
     worlds.reset = spy
-    data, steps = _collector(worlds).collect(2050, lambda obs, q: np.zeros(len(obs), dtype=int))
+    data, steps = _collector(worlds).collect(
+        2050, lambda obs, q, envs: np.zeros(len(obs), dtype=int))
     assert steps == 2060 and len(data) == 2050  # 100 steps: 2 episodes, 1 step of a third
     # one seeded reset; then the batched engine's autoreset continues each world's generator
     assert seeds[1:] == [None, None]
@@ -204,7 +205,7 @@ def test_collection_reuses_q_values_as_next_state_values():
         base = q(sets)
         return np.column_stack([base, -base, 2 * base, np.zeros_like(base)])
 
-    def policy(obs, values):
+    def policy(obs, values, envs):
         return values.argmax(axis=1) % 4
 
     data, _ = collector.collect(30 * 10 + 5, policy, q_values)  # crosses an episode end
@@ -358,6 +359,9 @@ def test_thesis_run_is_unchanged():
     ({"verbose": "yes"}, TypeError, "verbose must be an int or a bool"),
     ({"verbose": -1}, ValueError, "verbose must be >= 0"),
     ({"tie_break": "last"}, ValueError, "tie_break must be one of 'random', 'first'"),
+    ({"exploration_zeta": 1.0}, ValueError, "exploration_zeta must be greater than 1"),
+    ({"exploration_zeta": 0.5}, ValueError, r"exploration_zeta must lie in \[1.0, inf\]"),
+    ({"exploration_zeta": "2"}, TypeError, "exploration_zeta must be a number"),
 ])
 def test_bad_parameters(params, error, match):
     with pytest.raises(error, match=match):

@@ -231,7 +231,7 @@ def _plain_rollouts(seeds, policy, n_steps):
         env, transitions = Countdown(tag), []
         obs, _ = env.reset(seed=seed)
         while len(transitions) < n_steps:
-            action = int(policy(obs[None], None)[0])
+            action = int(policy(obs[None], None, np.array([tag]))[0])
             next_obs, reward, terminated, truncated, _ = env.step(action)
             transitions.append((*obs, action, reward, *next_obs, terminated))
             obs = env.reset()[0] if terminated or truncated else next_obs
@@ -244,7 +244,7 @@ def test_no_transition_spans_an_episode_boundary(mode):
     """Episodes of 1-5 steps, different in each of 4 envs: the collected transitions of each
     env are exactly a prefix of its plain rollout (no reset step recorded, no transition
     from an episode's end into the next one's start), under every autoreset mode."""
-    def policy(obs, q):
+    def policy(obs, q, envs):
         return (obs[:, 1] + obs[:, 2]).astype(int) % 2
 
     vector = countdowns(4, mode)
@@ -492,7 +492,8 @@ def test_evaluate_and_a_failed_set_env_close_the_envs_they_build_and_no_other():
 def test_save_load_round_trip_on_a_box_env(tmp_path):
     agent = FQI(classic_forest(bootstrap=False), "CartPole-v1", gamma=0.9,
                 samples_per_iteration=200, resample_every=1, max_samples=1000,
-                leaf_backups=2, n_envs=4, eval_episodes=2, seed=3).learn(n_iterations=2)
+                leaf_backups=2, exploration_zeta=2.0, n_envs=4, eval_episodes=2,
+                seed=3).learn(n_iterations=2)
     agent.save(tmp_path / "agent.joblib")
     loaded = FQI.load(tmp_path / "agent.joblib")
     for name in FQI._param_names():  # every constructor parameter, with no list kept by hand

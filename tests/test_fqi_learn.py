@@ -147,6 +147,43 @@ def test_exploration_falls_as_in_stable_baselines3s_dqn():
     assert rates[4:] == [0.2] * 4
 
 
+def _held_actions(agent, q, envs, n_steps):
+    """The actions `agent` collects with (`exploration_zeta`) over `n_steps` steps of the
+    envs `envs`, as an (n_steps, len(envs)) array."""
+    return np.array([agent._behaviour(None, q, envs) for _ in range(n_steps)])
+
+
+def test_exploration_zeta_holds_random_actions_for_zeta_distributed_durations():
+    agent = cartpole_agent(n_envs=3, exploration_zeta=2.0).learn(total_timesteps=300)
+    agent._held[:] = 0
+    everyone = np.arange(3)
+    random = _held_actions(agent, None, everyone, 20_000)  # before any fit: random play
+    assert set(np.unique(random)) == {0, 1}
+    # an action changes only where a hold ends: holds of mean ~6 steps (zeta(2), capped at
+    # 10,000) change it on ~1/12 of the steps, one-step random play on 1/2
+    changes = (random[1:] != random[:-1]).mean()
+    assert 0.02 < changes < 0.2, changes
+    one_step = _held_actions(cartpole_agent(n_envs=3).learn(total_timesteps=300), None,
+                             everyone, 2_000)
+    assert 0.45 < (one_step[1:] != one_step[:-1]).mean() < 0.55
+    # greedy once the holds have ended, with no new hold at epsilon 0
+    agent._held[1] = 0
+    agent.exploration_rate = 0.0
+    q = np.tile([[0.0, 1.0]], (3, 1))
+    assert (_held_actions(agent, q, everyone, 50) == 1).all()
+    # each env holds its own action, and only the envs that act count their steps down
+    agent.exploration_rate = 1.0
+    before = agent._held.copy()
+    _held_actions(agent, q[:1], np.array([2]), 5)
+    np.testing.assert_array_equal(agent._held[:, :2], before[:, :2])
+    assert agent._held[1, 2] > 0 or agent._held[1, 2] == 0 and before[1, 2] == 0
+    # same seed, same collection
+    twice = [cartpole_agent(n_envs=3, exploration_zeta=2.0, exploration_final_eps=0.5)
+             .learn(total_timesteps=900) for _ in range(2)]
+    assert [r["collect_reward_per_step"] for r in twice[0].history] == [
+        r["collect_reward_per_step"] for r in twice[1].history]
+
+
 def test_the_defaults_learn_cartpole_from_its_feature_vector():
     agent = FQI(ExtraTreesRegressor(n_estimators=10, min_samples_split=10, random_state=0),
                 "CartPole-v1", eval_episodes=0, seed=0).learn(total_timesteps=7_500)
