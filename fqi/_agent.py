@@ -34,11 +34,11 @@ __all__ = ["FQI"]
 _DEFAULT_ENVS = 16
 _TIE_BREAKS = ("random", "first")
 _TIE_TOLERANCE = 1e-6  # relative: Q-values closer than this to the best tie with it
+_MAX_HOLD = 10_000  # steps: the cap on the duration of a held exploratory action
 # What `save` leaves out (SB3 saves its __dict__ minus such a list): the envs, which hold
 # simulators, the transitions, the threads and the logs.
 _UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_held", "_data", "_csv_log",
                       "_logger"})
-_MAX_HOLD = 10_000  # steps: the cap on the duration of a held exploratory action
 # What a save holds beyond the constructor parameters.
 _LEARNED = ("_q", "history", "num_timesteps", "iteration", "observation_space",
             "action_space")
@@ -65,9 +65,9 @@ class FQI:
        `samples_per_iteration` transitions from the `n_envs` envs of a gymnasium vector env,
        with the uniform random policy at iteration 0 and the epsilon-greedy policy of
        ``Q_{n-1}`` later, epsilon falling as in stable-baselines3's DQN (with
-       `exploration_zeta`, each random action is held for a random number of steps). With `keep_data`
-       they are appended to the data set (oldest dropped beyond `max_samples`), else they
-       replace it;
+       `exploration_zeta`, each random action is held for a random number of steps). With
+       `keep_data` they are appended to the data set (oldest dropped beyond `max_samples`),
+       else they replace it;
     2. *targets*: ``r`` at iteration 0, then ``r + gamma * max_a Q_{n-1}(s', a)`` for every
        transition in the data set (no bootstrap after a termination; a truncation, such as
        a time limit, is bootstrapped through with the true final observation), then
