@@ -654,9 +654,9 @@ _GAMES = {  # name -> (env_id, env_kwargs, steps, eval_every, max_objects, FQI, 
 
 
 def _games(name, env_id, env_kwargs, steps, eval_every, max_objects, fqi, dqn, ppo, source,
-           tuned):
-    """A game's experiment; `tuned`: label -> a baseline's settings found by a search,
-    run at the game's `steps`."""
+           more):
+    """A game's experiment; `more`: label -> more settings (a baseline's found by a
+    search, another of FQI's), run at the game's `steps`."""
     game = env_kwargs.get("game", env_id)
     return Experiment(
         name, "extra", f"{game}: box FQI against DQN and PPO on the same objects", "games",
@@ -666,7 +666,7 @@ def _games(name, env_id, env_kwargs, steps, eval_every, max_objects, fqi, dqn, p
         settings={"box FQI": {"learner": "fqi", "steps": steps, **fqi},
                   f"DQN ({source})": {"learner": "DQN", "steps": steps, "hyperparams": dqn},
                   f"PPO ({source})": {"learner": "PPO", "steps": steps, "hyperparams": ppo},
-                  **{label: {**settings, "steps": steps} for label, settings in tuned.items()},
+                  **{label: {**settings, "steps": steps} for label, settings in more.items()},
                   "random policy": {"learner": "random"},
                   "scripted policy": {"learner": "scripted"}},
         notes=f"Mean return of 5 held-out episodes every {eval_every:,} of {steps:,} "
@@ -731,13 +731,18 @@ EXPERIMENTS += (Experiment(
     notes="A quarter of games_boxing's 500,000 steps, one seed, scored as there (5 held-out "
           "episodes every 25,000 steps); settings named by the rl-zoo3 entry they start "
           "from."),)
-# each algorithm's best final score there, at the games' budget
-_TUNED = {"games_boxing": {
+# More settings per game: on Boxing, each algorithm's best final score in the search above,
+# at the games' budget; on Freeway, whose reward is sparse, FQI with random actions held for
+# zeta-distributed durations (`exploration_zeta`, docs/games.md)
+_GAMES_MORE = {"games_boxing": {
     "DQN (rl-zoo3, learning starts 5,000, lr 5e-4)": _GAME_SEARCH_SETTINGS[
         "DQN, rl-zoo3 Atari, learning starts 5,000, lr 5e-4"],
     "PPO (rl-zoo3, gamma 0.9, sampled actions)": _GAME_SEARCH_SETTINGS[
-        "PPO, rl-zoo3 Atari, gamma 0.9, sampled actions"]}}
-EXPERIMENTS += tuple(_games(name, *spec, tuned=_TUNED.get(name, {}))
+        "PPO, rl-zoo3 Atari, gamma 0.9, sampled actions"]},
+    "games_freeway": {"box FQI, held exploration (zeta 2)": {
+        "learner": "fqi", **_ATARI_FQI,
+        "fqi": {**_ATARI_FQI["fqi"], "exploration_zeta": 2.0}}}}
+EXPERIMENTS += tuple(_games(name, *spec, more=_GAMES_MORE.get(name, {}))
                      for name, spec in _GAMES.items())
 
 REGISTRY = {experiment.name: experiment for experiment in EXPERIMENTS}
