@@ -59,3 +59,27 @@ def test_the_games_experiments_and_their_budgets():
     with pytest.raises(ValueError, match="sampled_actions is for the DQN and PPO learners"):
         kind.settings({"env_id": "highway-fast-v0", "learner": "fqi", "steps": 10,
                        "sampled_actions": True})
+
+
+def test_the_boxing_script_closes_in_keeps_off_level_and_punches_every_other_step():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from benchmarks.reproduce.kinds.games import _SCRIPTS, _ScriptedPolicy
+
+    names = ("NOOP", "FIRE", "UP", "RIGHT", "LEFT", "DOWN", "UPRIGHT", "UPLEFT", "DOWNRIGHT",
+             "DOWNLEFT")
+    env = SimpleNamespace(type_names=("Clock", "Enemy", "Player"), action_names=names)
+    policy = _ScriptedPolicy(_SCRIPTS["Boxing"](env))
+
+    def enemy_at(x, y):     # a row [x, y, w, h, dx, dy, type] relative to the player
+        return np.array([[x, y, 14.0, 46.0, 0.0, 0.0, 1.0]], dtype=np.float32)
+
+    far, level, in_reach = enemy_at(40, 20), enemy_at(-10, -2), enemy_at(10, 6)
+    # each position of the batch (an env) punches on its own every other step
+    for expected in (["DOWNRIGHT", "DOWN", "FIRE"], ["DOWNRIGHT", "DOWN", "NOOP"],
+                     ["DOWNRIGHT", "DOWN", "FIRE"]):
+        actions, _ = policy.predict([far, level, in_reach])
+        assert [names[a] for a in actions] == expected
+    assert names[policy.predict([np.empty((0, 7), dtype=np.float32)])[0][0]] == "NOOP"

@@ -37,7 +37,7 @@ def _pong(env):
     ball, actions = env.type_names.index("Ball"), env.action_names
     up, down, stay = actions.index("RIGHT"), actions.index("LEFT"), actions.index("NOOP")
 
-    def act(rows):
+    def act(rows, step):
         balls = rows[rows[:, -1] == ball]
         if not len(balls) or abs(balls[0, 1]) < 4:
             return stay
@@ -48,21 +48,25 @@ def _pong(env):
 def _freeway(env):
     """Always cross: UP."""
     up = env.action_names.index("UP")
-    return lambda rows: up
+    return lambda rows, step: up
 
 
 def _boxing(env):
-    """Walk to punching distance of the enemy, level with it, and punch."""
+    """Close in to 15 pixels across, keep 4 to 10 pixels of height from the enemy (punches
+    land off its level: docs/games.md), and punch every other step (a new punch needs the
+    button released)."""
     enemy, actions = env.type_names.index("Enemy"), env.action_names
+    near, low, high = 15, 4, 10
 
-    def act(rows):
+    def act(rows, step):
         enemies = rows[rows[:, -1] == enemy]
         if not len(enemies):
             return actions.index("NOOP")
         x, y = enemies[0, :2]
-        name = ("UP" if y < -4 else "DOWN" if y > 4 else "") + (
-            "RIGHT" if x > 30 else "LEFT" if x < -30 else "")
-        return actions.index(name or "FIRE")
+        vertical = ("DOWN" if y > 0 else "UP") if abs(y) > high else (
+            ("UP" if y > 0 else "DOWN") if abs(y) < low else "")
+        name = vertical + ("RIGHT" if x > near else "LEFT" if x < -near else "")
+        return actions.index(name or ("FIRE" if step % 2 == 0 else "NOOP"))
     return act
 
 
@@ -71,7 +75,7 @@ def _highway(env):
     actions = env.unwrapped.action_type.actions_indexes
     faster, slower = actions["FASTER"], actions["SLOWER"]
 
-    def act(rows):
+    def act(rows, step):
         ahead = (rows[:, 0] > 0) & (rows[:, 0] < 30) & (np.abs(rows[:, 1]) < 2)
         return slower if ahead[1:].any() else faster
     return act
@@ -82,14 +86,20 @@ _SCRIPTS = {"Pong": _pong, "Freeway": _freeway, "Boxing": _boxing,
 
 
 class _ScriptedPolicy:
-    """A rule from one observation's rows to an action, with the ``predict`` signature of
-    stable-baselines3 over a vector env's batch."""
+    """A rule from one env's observation rows and its count of steps so far to an action,
+    with the ``predict`` signature of stable-baselines3 over a vector env's batch (one count
+    per position in the batch)."""
 
     def __init__(self, rule):
-        self.rule = rule
+        self.rule, self._steps = rule, None
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        return np.array([self.rule(np.asarray(rows)) for rows in observation]), None
+        if self._steps is None or len(self._steps) != len(observation):
+            self._steps = np.zeros(len(observation), dtype=np.int64)
+        actions = np.array([self.rule(np.asarray(rows), step)
+                            for rows, step in zip(observation, self._steps)])
+        self._steps += 1
+        return actions, None
 
 
 @dataclass(frozen=True)
