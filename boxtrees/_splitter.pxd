@@ -22,6 +22,7 @@ cdef class _Splitter:
     # refine_tests: move the best test's edges and threshold to where the node's data put them
     cdef bint refine
     cdef vector[pair[coord_t, int32]] candidates    # one edge's objects: (key, sample)
+    cdef vector[pair[coord_t, int32]] sort_scratch  # as many, for their sort
     cdef vector[double] proxies                     # one edge's or threshold's positions
     # per sample, indexed by its current id (its position in the node order)
     cdef float64_t* target           # n_outputs per sample

@@ -33,6 +33,10 @@ from ._utils cimport (
     coord_t, float64_t, int32, intp_t, uint8, uint64, rand_int, rand_uniform, rand_unit,
 )
 
+cdef extern from "_radix.h":    # the sort of a refined edge's candidates
+    void boxtrees_sort_candidates(pair[coord_t, int32]* pairs, pair[coord_t, int32]* tmp,
+                                  intp_t n) noexcept nogil
+
 
 cnp.import_array()
 
@@ -67,6 +71,23 @@ def _set_simd(bint enabled):
     """
     global _kernels
     _kernels = boxtrees_select_kernels(enabled)
+
+
+def _sort_candidates(const coord_t[::1] keys, const int32[::1] ids):
+    """The pairs ``(keys[i], ids[i])`` sorted as a refined edge sorts its candidates (by key,
+    then id), as two arrays; exists to test that sort against NumPy's."""
+    cdef intp_t n = keys.shape[0], i
+    if ids.shape[0] != n:
+        raise ValueError("keys and ids must have the same length")
+    cdef vector[pair[coord_t, int32]] pairs, scratch
+    pairs.resize(n)
+    scratch.resize(n)
+    for i in range(n):
+        pairs[i] = pair[coord_t, int32](keys[i], ids[i])
+    if n:
+        boxtrees_sort_candidates(&pairs[0], &scratch[0], n)
+    return (np.array([p.first for p in pairs], dtype=np.float32),
+            np.array([p.second for p in pairs], dtype=np.int32))
 
 
 cdef inline coord_t _edge(const BoxTest* t, intp_t side) noexcept nogil:
@@ -348,7 +369,8 @@ cdef class _Splitter:
         cdef coord_t inner, outer, edge, old = _key(_edge(best, side), side)
         if m == 0:
             return False
-        sort(self.candidates.begin(), self.candidates.begin() + m)   # by key, ascending
+        self.sort_scratch.resize(m)     # by key, ascending, then by sample
+        boxtrees_sort_candidates(&self.candidates[0], &self.sort_scratch[0], m)
         self.proxies.resize(m)
         for k in range(n_outputs):
             self.sums[k] = 0.0

@@ -72,12 +72,14 @@ def main():
     for case, (n, per_sample, n_types, n_bands, spread, groups) in enumerate(
         # boxes hitting every sample (several times), ragged sets, no objects, objects outside
         # the bounds, two samples, more objects of a type than a SIMD step takes (16) and
-        # segments long enough to be searched; objects of 3, 1 and 6 attributes
+        # segments long enough to be searched; objects of 3, 1 and 6 attributes; refined
+        # edges with candidates enough for the radix sort (256)
         [(40, 6, 1, 1, 0.5, xy), (60, -12, 3, 4, 1.0, xy), (30, 0, 2, 3, 1.0, xy),
          (50, -3, 4, 8, 5.0, xy), (2, 1, 1, 1, 1.0, xy), (40, -60, 2, 2, 1.0, xy),
          (50, -20, 3, 4, 1.0, ((0, 1), (2,))), (40, -30, 2, 2, 1.0, ((0,),)),
          (30, -40, 2, 3, 1.0, ((0, 1), (2, 5), (4,), (3,))),
-         (40, -40, 2, 2, 1.0, ((0, 1, 2), (3,))), (30, -30, 3, 1, 1.0, ((4, 1, 0, 2, 3),))]
+         (40, -40, 2, 2, 1.0, ((0, 1, 2), (3,))), (30, -30, 3, 1, 1.0, ((4, 1, 0, 2, 3),)),
+         (100, 40, 1, 2, 1.0, xy)]
     ):
         data, offsets, objects = training_arrays(rng, n, per_sample, n_types, n_bands, spread,
                                                  groups)

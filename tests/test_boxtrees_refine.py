@@ -105,3 +105,23 @@ def test_bench_sets_writes_its_table_json_and_plot(tmp_path, capsys):
     refined = rows["box forest (fixed, refine_tests=true,bootstrap=true)"]
     assert refined["300"] > rows["box forest (fixed)"]["300"] and refined["300"] > 0.95
     assert "| presence | box forest (fixed) |" in report["markdown"] in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 255, 256, 257, 1000, 5000])
+def test_the_candidates_sort_orders_by_key_then_id_as_numpy_does(n):
+    from boxtrees._splitter import _sort_candidates
+
+    rng = np.random.default_rng(n)
+    # few distinct keys (ties broken by id), both zeros, negative and large keys, ids up to
+    # the largest int32
+    keys = rng.choice(np.array([-3e38, -2.5, -1.0, -0.0, 0.0, 1e-30, 0.5, 7.0, 3e38],
+                               dtype=np.float32), n)
+    keys[: n // 2] = rng.normal(size=n // 2).astype(np.float32)
+    ids = rng.integers(0, 2**31 - 1, n, dtype=np.int32)
+    ids[: n // 4] = rng.integers(0, 3, n // 4)       # repeated ids too
+    order = np.lexsort((ids, keys))                   # numpy: -0.0 and 0.0 are equal keys
+    sorted_keys, sorted_ids = _sort_candidates(keys, ids)
+    np.testing.assert_array_equal(sorted_ids, ids[order])
+    # the pairs are moved, not rewritten: each key keeps its sign of zero
+    np.testing.assert_array_equal(np.signbit(sorted_keys), np.signbit(keys[order]))
+    np.testing.assert_array_equal(sorted_keys, keys[order])
