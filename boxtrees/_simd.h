@@ -3,6 +3,8 @@
  *
  * - compact: the sample ids of a strip's objects whose y lies in (ymin, ymax);
  * - compact_box: the same for a whole short run, x tested too, so no search is needed;
+ * - compact_columns: the same for a box over more than two attributes, whose further
+ *   attributes are read in the objects' attribute rows;
  * - partition: renumber a run's sample ids and move, stably, the objects of the left child's
  *   samples (new id < mid) before those of the right child's;
  * - find_leaf: walk one sample down one tree (the AVX-512 version tests up to sixteen of the
@@ -33,6 +35,14 @@ typedef int64_t (*boxtrees_compact_fn)(const float *ys, const int32_t *sid, int6
 typedef int64_t (*boxtrees_compact_box_fn)(const float *xs, const float *ys, const int32_t *sid,
                                            int64_t n, float xmin, float xmax, float ymin,
                                            float ymax, int32_t *out);
+/* box: xmin, xmax, ymin, ymax; attribute columns[c] of the object of entry j (row oid[j] of
+   the n_attributes-wide `attributes`) must lie in (bounds[2c], bounds[2c + 1]), c < n_extra */
+typedef int64_t (*boxtrees_compact_columns_fn)(const float *xs, const float *ys,
+                                               const int32_t *oid, const int32_t *sid,
+                                               int64_t n, const float *box,
+                                               const float *attributes, int64_t n_attributes,
+                                               const int64_t *columns, const float *bounds,
+                                               int64_t n_extra, int32_t *out);
 typedef int64_t (*boxtrees_partition_fn)(float *xs, float *ys, int32_t *sid, int64_t n,
                                          const int32_t *new_id, int32_t mid, float *tmp_x,
                                          float *tmp_y, int32_t *tmp_sid);
@@ -70,6 +80,7 @@ typedef int64_t (*boxtrees_find_leaf_fn)(const boxtrees_node *nodes,
 typedef struct {
     boxtrees_compact_fn compact;
     boxtrees_compact_box_fn compact_box;
+    boxtrees_compact_columns_fn compact_columns;
     boxtrees_partition_fn partition;
     boxtrees_find_leaf_fn find_leaf;
 } boxtrees_kernels;
@@ -93,6 +104,27 @@ static int64_t boxtrees_compact_box_portable(const float *xs, const float *ys, c
     for (int64_t j = 0; j < n; j++) {
         out[k] = sid[j];
         k += (xs[j] > xmin) & (xs[j] < xmax) & (ys[j] > ymin) & (ys[j] < ymax);
+    }
+    return k;
+}
+
+static int64_t boxtrees_compact_columns_portable(const float *xs, const float *ys,
+                                                 const int32_t *oid, const int32_t *sid,
+                                                 int64_t n, const float *box,
+                                                 const float *attributes, int64_t n_attributes,
+                                                 const int64_t *columns, const float *bounds,
+                                                 int64_t n_extra, int32_t *out)
+{
+    int64_t k = 0;
+    for (int64_t j = 0; j < n; j++) {
+        int inside = (xs[j] > box[0]) & (xs[j] < box[1]) & (ys[j] > box[2]) & (ys[j] < box[3]);
+        const float *row = attributes + (int64_t)oid[j] * n_attributes;
+        for (int64_t c = 0; c < n_extra; c++) {
+            float v = row[columns[c]];
+            inside &= (v > bounds[2 * c]) & (v < bounds[2 * c + 1]);
+        }
+        out[k] = sid[j];
+        k += inside;
     }
     return k;
 }
@@ -221,6 +253,43 @@ static int64_t boxtrees_compact_avx512(const float *ys, const int32_t *sid, int6
     return k + boxtrees_compact_portable(ys + j, sid + j, n - j, ymin, ymax, out + k);
 }
 
+/* 16 entries a step, x and y compared at once; the further attributes are read for the
+   entries inside along x and y alone (a strip's entries are inside along x, most of them
+   outside along y). */
+__attribute__((target("avx512f")))
+static int64_t boxtrees_compact_columns_avx512(const float *xs, const float *ys,
+                                               const int32_t *oid, const int32_t *sid,
+                                               int64_t n, const float *box,
+                                               const float *attributes, int64_t n_attributes,
+                                               const int64_t *columns, const float *bounds,
+                                               int64_t n_extra, int32_t *out)
+{
+    const __m512 x0 = _mm512_set1_ps(box[0]), x1 = _mm512_set1_ps(box[1]);
+    const __m512 y0 = _mm512_set1_ps(box[2]), y1 = _mm512_set1_ps(box[3]);
+    int64_t k = 0;
+    for (int64_t j = 0; j < n; j += 16) {
+        __mmask16 live = n - j >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << (n - j)) - 1u);
+        __m512 x = _mm512_maskz_loadu_ps(live, xs + j), y = _mm512_maskz_loadu_ps(live, ys + j);
+        unsigned m = live & _mm512_cmp_ps_mask(x, x0, _CMP_GT_OQ) & _mm512_cmp_ps_mask(x, x1, _CMP_LT_OQ)
+                     & _mm512_cmp_ps_mask(y, y0, _CMP_GT_OQ) & _mm512_cmp_ps_mask(y, y1, _CMP_LT_OQ);
+        for (unsigned rest = m; rest; rest &= rest - 1) {
+            int lane = __builtin_ctz(rest);
+            const float *row = attributes + (int64_t)oid[j + lane] * n_attributes;
+            for (int64_t c = 0; c < n_extra; c++) {
+                float v = row[columns[c]];
+                if (!((v > bounds[2 * c]) & (v < bounds[2 * c + 1]))) {
+                    m &= ~(1u << lane);
+                    break;
+                }
+            }
+        }
+        __m512i s = _mm512_maskz_loadu_epi32(live, (const void *)(sid + j));
+        _mm512_storeu_si512((void *)(out + k), _mm512_maskz_compress_epi32((__mmask16)m, s));
+        k += __builtin_popcount(m);
+    }
+    return k;
+}
+
 /* Whole 16-lane stores are safe: neither count passes the objects already loaded, so they
    stay within the run and within a scratch as long as the run. The last partial block is left
    to the scalar loop. */
@@ -288,12 +357,14 @@ static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes,
 static inline boxtrees_kernels boxtrees_select_kernels(int allow_simd)
 {
     boxtrees_kernels k = {boxtrees_compact_portable, boxtrees_compact_box_portable,
-                          boxtrees_partition_portable, boxtrees_find_leaf_portable};
+                          boxtrees_compact_columns_portable, boxtrees_partition_portable,
+                          boxtrees_find_leaf_portable};
 #ifdef BOXTREES_AVX512
     __builtin_cpu_init();
     if (allow_simd && __builtin_cpu_supports("avx512f")) {
         k.compact = boxtrees_compact_avx512;
         k.compact_box = boxtrees_compact_box_avx512;
+        k.compact_columns = boxtrees_compact_columns_avx512;
         k.partition = boxtrees_partition_avx512;
         k.find_leaf = boxtrees_find_leaf_avx512;
     }

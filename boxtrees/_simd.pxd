@@ -11,6 +11,11 @@ cdef extern from "_simd.h":
         intp_t (*compact_box)(const coord_t* xs, const coord_t* ys, const int32* sid, intp_t n,
                               coord_t xmin, coord_t xmax, coord_t ymin, coord_t ymax,
                               int32* out) noexcept nogil
+        intp_t (*compact_columns)(const coord_t* xs, const coord_t* ys, const int32* oid,
+                                  const int32* sid, intp_t n, const coord_t* box,
+                                  const coord_t* attributes, intp_t n_attributes,
+                                  const intp_t* columns, const coord_t* bounds, intp_t n_extra,
+                                  int32* out) noexcept nogil
         intp_t (*partition)(coord_t* xs, coord_t* ys, int32* sid, intp_t n,
                             const int32* new_id, int32 mid, coord_t* tmp_x, coord_t* tmp_y,
                             int32* tmp_sid) noexcept nogil

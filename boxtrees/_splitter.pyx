@@ -613,21 +613,12 @@ cdef class _ObjectSplitter(_Splitter):
     cdef intp_t _compact_columns(self, const BoxTest* t, intp_t first, intp_t end) noexcept nogil:
         """The sample ids of the entries ``first:end`` of a segment of a group of more than
         two columns that lie inside the box along every column, in ``strip``; how many."""
-        cdef const intp_t* column = self.extra_column + t.group * MAX_EXTRA
-        cdef intp_t n_extra = self.group_size[t.group] - 2, j, c, n = 0
-        cdef const coord_t* row
-        cdef coord_t v
-        cdef bint inside
-        for j in range(first, end):
-            inside = ((t.xmin < self.xs[j]) & (self.xs[j] < t.xmax)
-                      & (t.ymin < self.ys[j]) & (self.ys[j] < t.ymax))
-            row = self.attributes + self.oid[j] * self.n_attributes
-            for c in range(n_extra):
-                v = row[column[c]]
-                inside &= (t.extra[2 * c] < v) & (v < t.extra[2 * c + 1])
-            self.strip[n] = self.sid[j]
-            n += inside
-        return n
+        cdef coord_t box[4]
+        box[0], box[1], box[2], box[3] = t.xmin, t.xmax, t.ymin, t.ymax
+        return _kernels.compact_columns(
+            self.xs + first, self.ys + first, self.oid + first, self.sid + first, end - first,
+            box, self.attributes, self.n_attributes, self.extra_column + t.group * MAX_EXTRA,
+            t.extra, self.group_size[t.group] - 2, self.strip)
 
     cdef bint evaluate(self, BoxTest* t) noexcept nogil:
         """Draw the threshold of a test and score it; False if its counts are constant."""

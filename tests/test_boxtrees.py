@@ -277,17 +277,34 @@ def test_max_depth_limits_trees():
     assert max(t.max_depth for t in trees_of(forest)) == 3
 
 
-def test_simd_and_portable_kernels_grow_identical_trees():
+def _objects_of_four_attributes(n, seed=0):
+    """Sets of up to 40 objects ``[a_0, ..., a_3, type]``, the target depending on all four
+    attributes: the default column groups then include boxes over three attributes."""
+    rng = np.random.default_rng(seed)
+    X = [np.column_stack([rng.uniform(-5, 5, (k, 4)), rng.integers(0, 3, k)]).astype(np.float32)
+         for k in rng.integers(0, 41, n)]
+    y = np.array([((x[:, 4] == 0) & (np.abs(x[:, :2]).max(axis=1) < 2) & (x[:, 2] > 0)
+                   & (x[:, 3] < 1)).sum() for x in X], dtype=float)
+    return X, y + rng.normal(0, 0.1, n)
+
+
+@pytest.mark.parametrize("d", [2, 4])
+def test_simd_and_portable_kernels_grow_identical_trees(d):
     from boxtrees import _splitter
 
-    X, y = make_box_regression(1500, random_state=0)
+    X, y = make_box_regression(1500, random_state=0) if d == 2 else _objects_of_four_attributes(1500)
     params = dict(n_estimators=3, n_tests=50, min_samples_split=10, random_state=0)
+    if d == 4:  # the defaults' column groups and refined tests
+        params = dict(params, column_groups=None, refine_tests=True)
     try:
         _splitter._set_simd(False)
         portable = thesis_forest(test_type="random", **params).fit(X, y)
     finally:
         _splitter._set_simd(True)
     simd = thesis_forest(test_type="random", **params).fit(X, y)
+    if d == 4:  # some boxes bound three attributes (the kernel that reads attribute rows)
+        assert any((np.isfinite(t.box[t.children_left >= 0]).sum(axis=1) > 4).any()
+                   for t in trees_of(simd))
     for a, b in zip(trees_of(portable), trees_of(simd)):
         np.testing.assert_array_equal(a.children_left, b.children_left)
         np.testing.assert_array_equal(a.box, b.box)
