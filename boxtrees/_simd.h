@@ -108,6 +108,19 @@ static int64_t boxtrees_compact_box_portable(const float *xs, const float *ys, c
     return k;
 }
 
+/* Whether the attributes columns[c] of an object's row lie in (bounds[2c], bounds[2c + 1]),
+   c < n_extra (1 or 0, without a branch). */
+static inline int boxtrees_extra_inside(const float *row, const int64_t *columns,
+                                        const float *bounds, int64_t n_extra)
+{
+    int inside = 1;
+    for (int64_t c = 0; c < n_extra; c++) {
+        float v = row[columns[c]];
+        inside &= (v > bounds[2 * c]) & (v < bounds[2 * c + 1]);
+    }
+    return inside;
+}
+
 static int64_t boxtrees_compact_columns_portable(const float *xs, const float *ys,
                                                  const int32_t *oid, const int32_t *sid,
                                                  int64_t n, const float *box,
@@ -118,11 +131,8 @@ static int64_t boxtrees_compact_columns_portable(const float *xs, const float *y
     int64_t k = 0;
     for (int64_t j = 0; j < n; j++) {
         int inside = (xs[j] > box[0]) & (xs[j] < box[1]) & (ys[j] > box[2]) & (ys[j] < box[3]);
-        const float *row = attributes + (int64_t)oid[j] * n_attributes;
-        for (int64_t c = 0; c < n_extra; c++) {
-            float v = row[columns[c]];
-            inside &= (v > bounds[2 * c]) & (v < bounds[2 * c + 1]);
-        }
+        inside &= boxtrees_extra_inside(attributes + (int64_t)oid[j] * n_attributes, columns,
+                                        bounds, n_extra);
         out[k] = sid[j];
         k += inside;
     }
@@ -274,14 +284,9 @@ static int64_t boxtrees_compact_columns_avx512(const float *xs, const float *ys,
                      & _mm512_cmp_ps_mask(y, y0, _CMP_GT_OQ) & _mm512_cmp_ps_mask(y, y1, _CMP_LT_OQ);
         for (unsigned rest = m; rest; rest &= rest - 1) {
             int lane = __builtin_ctz(rest);
-            const float *row = attributes + (int64_t)oid[j + lane] * n_attributes;
-            for (int64_t c = 0; c < n_extra; c++) {
-                float v = row[columns[c]];
-                if (!((v > bounds[2 * c]) & (v < bounds[2 * c + 1]))) {
-                    m &= ~(1u << lane);
-                    break;
-                }
-            }
+            if (!boxtrees_extra_inside(attributes + (int64_t)oid[j + lane] * n_attributes,
+                                       columns, bounds, n_extra))
+                m &= ~(1u << lane);
         }
         __m512i s = _mm512_maskz_loadu_epi32(live, (const void *)(sid + j));
         _mm512_storeu_si512((void *)(out + k), _mm512_maskz_compress_epi32((__mmask16)m, s));

@@ -2,13 +2,16 @@
 scripted policy, end to end at the tiny budget (Atari episodes capped at 800 frames)."""
 import importlib.util
 import json
+from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 from benchmarks.reproduce import BUDGETS, REGISTRY
 from benchmarks.reproduce.cache import unit_path
 from benchmarks.reproduce.cli import main
 from benchmarks.reproduce.kinds import KINDS
+from benchmarks.reproduce.kinds.games import _SCRIPTS, _ScriptedPolicy
 
 from harness import TINY
 
@@ -62,12 +65,6 @@ def test_the_games_experiments_and_their_budgets():
 
 
 def test_the_boxing_script_closes_in_keeps_off_level_and_punches_every_other_step():
-    from types import SimpleNamespace
-
-    import numpy as np
-
-    from benchmarks.reproduce.kinds.games import _SCRIPTS, _ScriptedPolicy
-
     names = ("NOOP", "FIRE", "UP", "RIGHT", "LEFT", "DOWN", "UPRIGHT", "UPLEFT", "DOWNRIGHT",
              "DOWNLEFT")
     env = SimpleNamespace(type_names=("Clock", "Enemy", "Player"), action_names=names)
