@@ -25,6 +25,8 @@ TYPE_NAMES = tuple(name.replace("_", " ") for name in envs.TYPE_NAMES)
 ACTION_NAMES = tuple(name.replace("_", " ") for name in envs.ACTION_NAMES)
 # reference policies' lines, best first (a planner, a heuristic, random play)
 _REFERENCE_COLOURS = ("black", "dimgrey", "darkgrey", "silver")
+# curves whose last steps differ this many times are drawn on a log scale of steps
+_LOG_STEPS = 5
 
 
 def save(fig, path):
@@ -105,7 +107,9 @@ def versus_steps(experiment, stats, curves, budget, ylabel="reward per 20,000 gr
     """Reward against environment steps, mean +- 1 sd over runs (`curves`: label ->
     ``(steps, mean, sd)`` of its kind's ``curve``: FQI after each iteration, the random
     policy at 0; the baselines at their checkpoints); settings without a curve (reference
-    policies) as horizontal lines, and a `threshold` (a task's "solved") dotted."""
+    policies) as horizontal lines, and a `threshold` (a task's "solved") dotted. Steps are
+    on a log scale when the curves' budgets differ `_LOG_STEPS` times or more (and no curve
+    starts at 0)."""
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
     references = 0
     for label, s in stats.items():
@@ -128,6 +132,11 @@ def versus_steps(experiment, stats, curves, budget, ylabel="reward per 20,000 gr
                     xycoords=("axes fraction", "data"), textcoords="offset points",
                     fontsize=7)
     ax.set_xlabel("environment steps")
+    ends = [curve[0][-1] for curve in curves.values() if curve is not None and len(curve[0])]
+    starts = [curve[0][0] for curve in curves.values() if curve is not None and len(curve[0])]
+    if ends and min(starts) > 0 and max(ends) >= _LOG_STEPS * min(ends):
+        ax.set_xscale("log")  # budgets this far apart would squeeze the shorter curves
+        ax.set_xlabel("environment steps (log scale)")
     ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
     ax.yaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
     ax.set_ylabel(ylabel)
