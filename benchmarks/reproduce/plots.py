@@ -132,9 +132,9 @@ def versus_steps(experiment, stats, curves, budget, ylabel="reward per 20,000 gr
                     xycoords=("axes fraction", "data"), textcoords="offset points",
                     fontsize=7)
     ax.set_xlabel("environment steps")
-    ends = [curve[0][-1] for curve in curves.values() if curve is not None and len(curve[0])]
-    starts = [curve[0][0] for curve in curves.values() if curve is not None and len(curve[0])]
-    if ends and min(starts) > 0 and max(ends) >= _LOG_STEPS * min(ends):
+    steps = [curve[0] for curve in curves.values() if curve is not None and len(curve[0])]
+    ends = [x[-1] for x in steps]
+    if steps and min(x[0] for x in steps) > 0 and max(ends) >= _LOG_STEPS * min(ends):
         ax.set_xscale("log")  # budgets this far apart would squeeze the shorter curves
         ax.set_xlabel("environment steps (log scale)")
     ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))

@@ -584,7 +584,8 @@ _CONTROL_FQI = {"FQI, Extra-Trees": "extra-trees",
                 "FQI, boxtrees classic": "box-classic"}
 
 
-# the envs run before `tie_break` existed, whose first-action-tie runs stay beside the new
+# the envs run before `tie_break` existed: their first-action-tie runs stay beside those
+# with ties broken at random
 _CONTROL_FIRST_TIES = ("CartPole-v1", "Acrobot-v1")
 
 
