@@ -154,15 +154,20 @@ def test_the_control_runs_measured_fqis_current_defaults():
     assert {name: defaults[name] for name in FQI_DEFAULTS_MEASURED} == FQI_DEFAULTS_MEASURED
 
 
-@pytest.mark.parametrize("name, first_ties", [("control_cartpole", True),
-                                               ("control_acrobot", True),
-                                               ("control_mountaincar", False),
-                                               ("control_lunarlander", False)])
-def test_first_action_tie_runs_only_where_they_were_made(name, first_ties):
+@pytest.mark.parametrize("name, first_ties, held", [("control_cartpole", True, False),
+                                                     ("control_acrobot", True, False),
+                                                     ("control_mountaincar", False, True),
+                                                     ("control_lunarlander", False, False)])
+def test_first_action_tie_runs_only_where_they_were_made(name, first_ties, held):
     """The envs run before `tie_break` existed keep those runs beside the new default's; the
-    others run each FQI setting once, with ties broken at random."""
+    others run each FQI setting once, with ties broken at random; MountainCar alone adds a
+    setting with held random actions."""
     labels = list(REGISTRY[name].settings)
     tied = [label for label in labels if label.endswith(", first-action ties")]
     assert len(tied) == (3 if first_ties else 0)
-    assert sum(label.startswith("FQI") for label in labels) == (7 if first_ties else 4)
+    held_labels = [label for label in labels if label.endswith(", held exploration")]
+    assert len(held_labels) == held
+    for label in held_labels:
+        assert REGISTRY[name].settings[label]["fqi"]["exploration_zeta"] == 1.5
+    assert sum(label.startswith("FQI") for label in labels) == 4 + 3 * first_ties + held
     assert {"DQN (rl-zoo3)", "PPO (rl-zoo3)"} <= set(labels)
