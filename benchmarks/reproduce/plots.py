@@ -125,7 +125,9 @@ def versus_steps(experiment, stats, curves, budget, ylabel="reward per 20,000 gr
         ax.plot(x, mean, marker="o", markersize=3, label=f"{label} ({s.score:,.0f}, "
                 f"{s.seconds / 60:.0f} min/run)")
         ax.fill_between(x, mean - sd, mean + sd, alpha=0.2)
-    ax.axhline(0, color="grey", lw=0.6)
+    low, high = ax.get_ylim()
+    if low < 0 < high:  # a zero line only where it is in the data's range, not to stretch it
+        ax.axhline(0, color="grey", lw=0.6)
     if threshold is not None:
         ax.axhline(threshold, color="black", ls=":", lw=1.0)
         ax.annotate(f"solved ({threshold:,.0f})", (0, threshold), xytext=(2, 3),
@@ -141,8 +143,9 @@ def versus_steps(experiment, stats, curves, budget, ylabel="reward per 20,000 gr
     ax.yaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
     ax.set_ylabel(ylabel)
     ax.set_title(_title(experiment, budget, stats), fontsize=10)
-    ax.legend(fontsize=7, loc="lower right", title="method (final score, wall time)",
-              title_fontsize=7)
+    # below the axes: with many settings a legend inside would hide the curves
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14),
+              title="method (final score, wall time)", title_fontsize=7)
     ax.grid(alpha=0.3)
     return fig
 

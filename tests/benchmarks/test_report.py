@@ -3,6 +3,7 @@ import json
 import re
 import shutil
 from dataclasses import replace
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -37,6 +38,28 @@ def test_summarise_fqi_runs():
 
 
 # ------------------------------------------------------------------------------ report
+@pytest.mark.parametrize("offset, zero_line", [(-150.0, False), (0.0, True)])
+def test_versus_steps_zero_line_only_in_range_and_legend_below(offset, zero_line):
+    """All-negative returns (MountainCar's) are not stretched up to a zero line, and the
+    legend sits under the axes, off the curves."""
+    steps = np.array([5_000, 10_000, 15_000])
+    curves = {"a": (steps, offset + np.array([-50.0, 20.0, 40.0]), np.full(3, 5.0)),
+              "b": (steps, offset + np.array([-40.0, -10.0, 30.0]), np.full(3, 5.0))}
+    stats = {label: SimpleNamespace(score=curve[1][-1], seconds=60.0, n_runs=2)
+             for label, curve in curves.items()}
+    fig = plots.versus_steps(REGISTRY["control_mountaincar"], stats, curves, TINY,
+                             threshold=offset - 20.0)
+    ax = fig.axes[0]
+    zero_lines = [line for line in ax.get_lines() if tuple(line.get_ydata()) == (0, 0)]
+    assert len(zero_lines) == zero_line
+    low, high = ax.get_ylim()
+    assert (low < 0 < high) == zero_line
+    fig.canvas.draw()
+    legend_box = ax.get_legend().get_window_extent()
+    assert legend_box.y1 < ax.get_window_extent().y0  # wholly below the axes
+    plots.plt.close(fig)
+
+
 def test_report_shows_thesis_numbers_beside_ours_and_computed_verdicts(tmp_path):
     experiment = REGISTRY["sampling"]
     budget = replace(TINY, iterations=3)
