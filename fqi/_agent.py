@@ -129,7 +129,8 @@ class FQI:
         greedily otherwise; the first round holds random actions the same way. Random play
         that repeats its actions travels far (its displacement grows with the hold
         durations), where one-step random play dithers in place: the remedy for a sparse
-        reward far from the start (Atari's Freeway: ``docs/games.md``). 2 is the paper's
+        reward far from the start (Atari's Freeway: ``docs/games.md``; MountainCar-v0, with
+        1.5 and epsilon kept up over half the steps: ``docs/fqi.md``). 2 is the paper's
         choice. `predict` with ``deterministic=False`` stays one-step epsilon-greedy.
     tie_break : {"random", "first"}, default="random"
         How the collection's greedy action is chosen among tied ones (Q-values within a
