@@ -1,10 +1,10 @@
 """Build the Cython core of ``boxtrees``.
 
 Metadata lives in ``pyproject.toml``; this file only declares the extension modules.
-The build is portable on every platform: no ``-march`` and no ``-mavx512*`` flag. The
+The build is portable on every platform: no ``-march`` and no ``-mavx*`` flag. The AVX2 and
 AVX-512 kernels of ``boxtrees/_simd.h`` carry their own target attributes, are compiled
 only by GCC or clang targeting x86-64 outside macOS and Windows (so on Linux), and run only
-when the CPU has AVX-512F (checked at import); builds with MSVC, for macOS (either
+when the CPU has AVX2 or AVX-512F (checked at import); builds with MSVC, for macOS (either
 architecture) or for ARM have the portable kernels alone. The inner loops are written so
 that the compiler can vectorise them at the baseline instruction set.
 """

@@ -12,7 +12,7 @@ only the sample's objects of the tested type, attribute by attribute; they re-va
 of use, the rows and offsets they read (a batch may have changed since it was checked), and
 report the first bad row instead of reading past an array. Samples are processed in blocks,
 tree by tree, so that a tree's nodes stay in cache across a block. The walk itself is a kernel
-of ``_simd.h``: with AVX-512 it tests all of a sample's objects of a type at once.
+of ``_simd.h``: with AVX-512 it tests up to 16 of a sample's objects of a type at once.
 """
 import numpy as np
 
@@ -33,7 +33,7 @@ cdef enum:
     BLOCK = 64
 
 # the traversal kernel (see _simd.h)
-cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)
+cdef boxtrees_kernels _kernels = boxtrees_select_kernels(16)
 # what empty object arrays point to: the kernels read nothing through it
 cdef coord_t _NO_OBJECT = 0
 
@@ -44,13 +44,16 @@ _NODE_FIELDS = {  # BoxTree array -> (dtype kind, trailing shape)
 _INT32 = np.iinfo(np.int32)
 
 
-def _set_simd(bint enabled):
-    """Use the SIMD traversal when the CPU has it (default) or the portable one.
+def _set_simd(int max_lanes=16):
+    """Use the AVX-512 traversal kernel (``max_lanes=16``, the default, where the CPU has it)
+    or the portable one (any other ``max_lanes``: an AVX2 walk is no faster than it).
 
-    Both give identical results; this switch exists to test that.
+    Both give identical results; this switch exists to test that. Returns the lanes of the
+    kernel now in use, 16 or 1.
     """
     global _kernels
-    _kernels = boxtrees_select_kernels(enabled)
+    _kernels = boxtrees_select_kernels(max_lanes)
+    return 16 if _kernels.lanes == 16 else 1
 
 
 cdef struct ForestView:

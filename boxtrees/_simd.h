@@ -1,5 +1,5 @@
-/* The data-parallel kernels of the tree builder and of the traversal, each in a portable and
- * an AVX-512 version.
+/* The data-parallel kernels of the tree builder and of the traversal, each in a portable
+ * version and, on x86-64, in versions for AVX2 and for AVX-512.
  *
  * - compact: the sample ids of a strip's objects whose y lies in (ymin, ymax);
  * - compact_box: the same for a whole short run, x tested too, so no search is needed;
@@ -11,12 +11,15 @@
  *   sample's objects of a type at once, with no loop to mispredict).
  *
  * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
- * run time, so the default build stays portable) sixteen objects are handled per step. Both
- * versions write exactly the same results; the AVX-512 compactions may write up to 16 slots
- * past the returned count, so `out` needs 16 spare slots.
+ * run time, so the default build stays portable) sixteen objects are handled per step; with
+ * AVX2 alone, eight in the compactions (the partition and the traversal keep their scalar
+ * loops there: AVX2 has neither compress nor mask registers, and an AVX2 walk, tried, was
+ * slower than the scalar one). All versions write exactly the same results;
+ * the SIMD compactions may write up to 16 slots past the returned count, so `out` needs 16
+ * spare slots.
  *
- * The AVX-512 versions are compiled where BOXTREES_AVX512 is defined: by GCC or clang for
- * x86-64 Linux (and other ELF systems), through per-function target attributes (no -mavx512*
+ * The SIMD versions are compiled where BOXTREES_X86_SIMD is defined: by GCC or clang for
+ * x86-64 Linux (and other ELF systems), through per-function target attributes (no -mavx*
  * flag, so the rest of the module runs on any x86-64). Elsewhere only the portable versions
  * exist: on ARM; on Windows, where MSVC has neither the target attribute nor
  * __builtin_cpu_supports and GCC does not align the stack for spilled 64-byte vectors; and on
@@ -83,6 +86,7 @@ typedef struct {
     boxtrees_compact_columns_fn compact_columns;
     boxtrees_partition_fn partition;
     boxtrees_find_leaf_fn find_leaf;
+    int lanes; /* objects a step: 16 (AVX-512), 8 (AVX2) or 1 (portable) */
 } boxtrees_kernels;
 
 static int64_t boxtrees_compact_portable(const float *ys, const int32_t *sid, int64_t n,
@@ -221,11 +225,115 @@ static int64_t boxtrees_find_leaf_portable(const boxtrees_node *nodes,
 }
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(__APPLE__) && !defined(_WIN32)
-#define BOXTREES_AVX512 1
+#define BOXTREES_X86_SIMD 1
 #endif
 
-#ifdef BOXTREES_AVX512
+#ifdef BOXTREES_X86_SIMD
 #include <immintrin.h>
+
+/* AVX2 compaction: for each 8-bit mask of the lanes kept, the kept lanes' indices in order,
+   one byte each (the rest 0), widened to the vpermd indices that pack those lanes first. */
+struct boxtrees_lane_order {
+    uint64_t lanes[256];
+};
+
+static constexpr boxtrees_lane_order boxtrees_make_lane_order()
+{
+    boxtrees_lane_order order{};
+    for (int mask = 0; mask < 256; mask++) {
+        int kept = 0;
+        for (int lane = 0; lane < 8; lane++)
+            if (mask >> lane & 1)
+                order.lanes[mask] |= (uint64_t)lane << (8 * kept++);
+    }
+    return order;
+}
+
+static constexpr boxtrees_lane_order BOXTREES_LANE_ORDER = boxtrees_make_lane_order();
+
+/* Store the lanes of `ids` set in `mask` packed at `out` (all 8 lanes are written); how many. */
+__attribute__((target("avx2,popcnt")))
+static inline int64_t boxtrees_store_kept_avx2(__m256i ids, unsigned mask, int32_t *out)
+{
+    __m128i order = _mm_loadl_epi64((const __m128i *)(BOXTREES_LANE_ORDER.lanes + mask));
+    _mm256_storeu_si256((__m256i *)out,
+                        _mm256_permutevar8x32_epi32(ids, _mm256_cvtepu8_epi32(order)));
+    return __builtin_popcount(mask);
+}
+
+/* The lanes of x and y strictly inside (x0, x1) x (y0, y1), as a bit mask. */
+__attribute__((target("avx2")))
+static inline unsigned boxtrees_inside_avx2(__m256 x, __m256 y, __m256 x0, __m256 x1, __m256 y0,
+                                            __m256 y1)
+{
+    __m256 in = _mm256_and_ps(
+        _mm256_and_ps(_mm256_cmp_ps(x, x0, _CMP_GT_OQ), _mm256_cmp_ps(x, x1, _CMP_LT_OQ)),
+        _mm256_and_ps(_mm256_cmp_ps(y, y0, _CMP_GT_OQ), _mm256_cmp_ps(y, y1, _CMP_LT_OQ)));
+    return (unsigned)_mm256_movemask_ps(in);
+}
+
+__attribute__((target("avx2,popcnt")))
+static int64_t boxtrees_compact_box_avx2(const float *xs, const float *ys, const int32_t *sid,
+                                         int64_t n, float xmin, float xmax, float ymin,
+                                         float ymax, int32_t *out)
+{
+    const __m256 x0 = _mm256_set1_ps(xmin), x1 = _mm256_set1_ps(xmax);
+    const __m256 y0 = _mm256_set1_ps(ymin), y1 = _mm256_set1_ps(ymax);
+    int64_t j = 0, k = 0;
+    for (; j + 8 <= n; j += 8) {
+        unsigned m = boxtrees_inside_avx2(_mm256_loadu_ps(xs + j), _mm256_loadu_ps(ys + j), x0,
+                                          x1, y0, y1);
+        k += boxtrees_store_kept_avx2(_mm256_loadu_si256((const __m256i *)(sid + j)), m,
+                                      out + k);
+    }
+    return k + boxtrees_compact_box_portable(xs + j, ys + j, sid + j, n - j, xmin, xmax, ymin,
+                                             ymax, out + k);
+}
+
+__attribute__((target("avx2,popcnt")))
+static int64_t boxtrees_compact_avx2(const float *ys, const int32_t *sid, int64_t n, float ymin,
+                                     float ymax, int32_t *out)
+{
+    const __m256 lo = _mm256_set1_ps(ymin), hi = _mm256_set1_ps(ymax);
+    int64_t j = 0, k = 0;
+    for (; j + 8 <= n; j += 8) {
+        __m256 y = _mm256_loadu_ps(ys + j);
+        unsigned m = (unsigned)_mm256_movemask_ps(
+            _mm256_and_ps(_mm256_cmp_ps(y, lo, _CMP_GT_OQ), _mm256_cmp_ps(y, hi, _CMP_LT_OQ)));
+        k += boxtrees_store_kept_avx2(_mm256_loadu_si256((const __m256i *)(sid + j)), m,
+                                      out + k);
+    }
+    return k + boxtrees_compact_portable(ys + j, sid + j, n - j, ymin, ymax, out + k);
+}
+
+/* The extra attributes are read for the entries inside along x and y alone, as in the
+   AVX-512 version. */
+__attribute__((target("avx2,popcnt")))
+static int64_t boxtrees_compact_columns_avx2(const float *xs, const float *ys,
+                                             const int32_t *oid, const int32_t *sid, int64_t n,
+                                             const float *box, const float *attributes,
+                                             int64_t n_attributes, const int64_t *columns,
+                                             const float *bounds, int64_t n_extra, int32_t *out)
+{
+    const __m256 x0 = _mm256_set1_ps(box[0]), x1 = _mm256_set1_ps(box[1]);
+    const __m256 y0 = _mm256_set1_ps(box[2]), y1 = _mm256_set1_ps(box[3]);
+    int64_t j = 0, k = 0;
+    for (; j + 8 <= n; j += 8) {
+        unsigned m = boxtrees_inside_avx2(_mm256_loadu_ps(xs + j), _mm256_loadu_ps(ys + j), x0,
+                                          x1, y0, y1);
+        for (unsigned rest = m; rest; rest &= rest - 1) {
+            int lane = __builtin_ctz(rest);
+            if (!boxtrees_extra_inside(attributes + (int64_t)oid[j + lane] * n_attributes,
+                                       columns, bounds, n_extra))
+                m &= ~(1u << lane);
+        }
+        k += boxtrees_store_kept_avx2(_mm256_loadu_si256((const __m256i *)(sid + j)), m,
+                                      out + k);
+    }
+    return k + boxtrees_compact_columns_portable(xs + j, ys + j, oid + j, sid + j, n - j, box,
+                                                 attributes, n_attributes, columns, bounds,
+                                                 n_extra, out + k);
+}
 
 __attribute__((target("avx512f")))
 static int64_t boxtrees_compact_box_avx512(const float *xs, const float *ys, const int32_t *sid,
@@ -357,24 +465,32 @@ static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes,
 }
 #endif
 
-/* The fastest kernels this CPU runs, or the portable ones when `allow_simd` is 0 (inline: the
-   modules that include this header for its records alone do not call it). */
-static inline boxtrees_kernels boxtrees_select_kernels(int allow_simd)
+/* The fastest kernels this CPU runs with at most `max_lanes` lanes: 16 (AVX-512F), 8 (AVX2) or
+   1 (the portable ones). Inline: the modules that include this header for its records alone
+   do not call it. */
+static inline boxtrees_kernels boxtrees_select_kernels(int max_lanes)
 {
     boxtrees_kernels k = {boxtrees_compact_portable, boxtrees_compact_box_portable,
                           boxtrees_compact_columns_portable, boxtrees_partition_portable,
-                          boxtrees_find_leaf_portable};
-#ifdef BOXTREES_AVX512
+                          boxtrees_find_leaf_portable, 1};
+#ifdef BOXTREES_X86_SIMD
     __builtin_cpu_init();
-    if (allow_simd && __builtin_cpu_supports("avx512f")) {
+    if (max_lanes >= 16 && __builtin_cpu_supports("avx512f")) {
         k.compact = boxtrees_compact_avx512;
         k.compact_box = boxtrees_compact_box_avx512;
         k.compact_columns = boxtrees_compact_columns_avx512;
         k.partition = boxtrees_partition_avx512;
         k.find_leaf = boxtrees_find_leaf_avx512;
+        k.lanes = 16;
+    } else if (max_lanes >= 8 && __builtin_cpu_supports("avx2")
+               && __builtin_cpu_supports("popcnt")) {
+        k.compact = boxtrees_compact_avx2;
+        k.compact_box = boxtrees_compact_box_avx2;
+        k.compact_columns = boxtrees_compact_columns_avx2;
+        k.lanes = 8;
     }
 #else
-    (void)allow_simd;
+    (void)max_lanes;
 #endif
     return k;
 }

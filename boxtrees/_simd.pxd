@@ -22,4 +22,5 @@ cdef extern from "_simd.h":
         intp_t (*find_leaf)(const boxtrees_node* nodes, const boxtrees_extra* extras,
                             const coord_t* features, intp_t stride,
                             const intp_t* types) noexcept nogil
-    boxtrees_kernels boxtrees_select_kernels(int allow_simd) noexcept nogil
+        int lanes
+    boxtrees_kernels boxtrees_select_kernels(int max_lanes) noexcept nogil

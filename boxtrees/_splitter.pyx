@@ -61,16 +61,19 @@ cdef double TIE_TOLERANCE = 1e-11
 cdef double FEATURE_THRESHOLD = 1e-7
 
 # the data-parallel kernels used by every tree (see _simd.h)
-cdef boxtrees_kernels _kernels = boxtrees_select_kernels(1)
+cdef boxtrees_kernels _kernels = boxtrees_select_kernels(16)
 
 
-def _set_simd(bint enabled):
-    """Use the SIMD kernels when the CPU has them (default) or the portable ones.
+def _set_simd(int max_lanes=16):
+    """Use the widest kernels the CPU runs with at most ``max_lanes`` lanes.
 
-    Both give identical trees; this switch exists to test that.
+    16: AVX-512 (the default, where the CPU has it), 8: AVX2, 1: the portable ones. All give
+    identical results; this switch exists to test that. Returns the lanes of the kernels
+    now in use.
     """
     global _kernels
-    _kernels = boxtrees_select_kernels(enabled)
+    _kernels = boxtrees_select_kernels(max_lanes)
+    return _kernels.lanes
 
 
 def _sort_candidates(const coord_t[::1] keys, const int32[::1] ids):

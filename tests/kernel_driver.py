@@ -69,6 +69,8 @@ def training_arrays(rng, n, per_sample, n_types, n_bands, spread, groups):
 def main():
     rng = np.random.default_rng(0)
     xy = ((0, 1),)
+    # every kernel width this CPU runs: AVX-512 (16 lanes), AVX2 (8), portable (1)
+    widths = sorted({_splitter._set_simd(lanes) for lanes in (16, 8, 1)}, reverse=True)
     for case, (n, per_sample, n_types, n_bands, spread, groups) in enumerate(
         # boxes hitting every sample (several times), ragged sets, no objects, objects outside
         # the bounds, two samples, more objects of a type than a SIMD step takes (16) and
@@ -86,9 +88,9 @@ def main():
         d = data.shape[1] - 1
         target, weight = rng.normal(size=n), rng.uniform(0.5, 2, n)
         for test_type in ("random", "fixed", "bounded", "classic"):
-            for simd in (True, False):
-                _splitter._set_simd(simd)
-                _predictor._set_simd(simd)
+            for lanes in widths:
+                _splitter._set_simd(lanes)
+                _predictor._set_simd(lanes)
                 # one output, then two (multi-output sums)
                 targets = target if seed_outputs(case) == 1 else np.column_stack([target, weight])
                 # refined tests on the first tree; zero weights drop samples in the third

@@ -46,14 +46,24 @@ def reference_leaf(tree, objects):
     return node
 
 
-@pytest.fixture(params=[True, False], ids=["simd", "portable"])
+KERNEL_WIDTHS = {"avx512": 16, "avx2": 8}  # the SIMD kernels' lanes, widest first
+
+
+def _use_kernels(module, lanes):
+    """Select ``module``'s kernels of ``lanes`` lanes, or skip where the CPU lacks them."""
+    if module._set_simd(lanes) != lanes:
+        module._set_simd()
+        pytest.skip(f"the CPU does not run the {lanes}-lane kernels")
+
+
+@pytest.fixture(params=[16, 1], ids=["avx512", "portable"])
 def traversal_kernel(request):
-    """Run the test with the SIMD traversal kernel (when the CPU has it) and the portable one."""
+    """Run the test with each traversal kernel the CPU runs: AVX-512 and portable."""
     from boxtrees import _predictor
 
-    _predictor._set_simd(request.param)
+    _use_kernels(_predictor, request.param)
     yield
-    _predictor._set_simd(True)
+    _predictor._set_simd()
 
 
 @pytest.mark.parametrize("test_type", TEST_TYPES)
@@ -288,8 +298,9 @@ def _objects_of_four_attributes(n, seed=0):
     return X, y + rng.normal(0, 0.1, n)
 
 
+@pytest.mark.parametrize("lanes", KERNEL_WIDTHS.values(), ids=KERNEL_WIDTHS)
 @pytest.mark.parametrize("d", [2, 4])
-def test_simd_and_portable_kernels_grow_identical_trees(d):
+def test_simd_and_portable_kernels_grow_identical_trees(d, lanes):
     from boxtrees import _splitter
 
     X, y = make_box_regression(1500, random_state=0) if d == 2 else _objects_of_four_attributes(1500)
@@ -297,11 +308,12 @@ def test_simd_and_portable_kernels_grow_identical_trees(d):
     if d == 4:  # the defaults' column groups and refined tests
         params = dict(params, column_groups=None, refine_tests=True)
     try:
-        _splitter._set_simd(False)
+        _splitter._set_simd(1)
         portable = thesis_forest(test_type="random", **params).fit(X, y)
+        _use_kernels(_splitter, lanes)
+        simd = thesis_forest(test_type="random", **params).fit(X, y)
     finally:
-        _splitter._set_simd(True)
-    simd = thesis_forest(test_type="random", **params).fit(X, y)
+        _splitter._set_simd()
     if d == 4:  # some boxes bound three attributes (the kernel that reads attribute rows)
         assert any((np.isfinite(t.box[t.children_left >= 0]).sum(axis=1) > 4).any()
                    for t in trees_of(simd))

@@ -1,7 +1,7 @@
 """Memory safety of the SIMD kernels: no invalid read or write under AddressSanitizer.
 
 valgrind (test_boxtrees_memcheck.py) cannot execute AVX-512 instructions, so under it the
-kernels take their portable paths. AddressSanitizer instruments the compiled code instead and
+kernels take their AVX2 or portable paths. AddressSanitizer instruments the compiled code instead and
 runs natively, SIMD paths included: this test builds boxtrees with it into a temporary folder
 and runs the kernel driver there, then the mutation fuzz tests of test_boxtrees_safety.py.
 """
