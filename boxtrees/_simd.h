@@ -13,10 +13,10 @@
  * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
  * run time, so the default build stays portable) sixteen objects are handled per step; with
  * AVX2 alone, eight in the compactions (the partition and the traversal keep their scalar
- * loops there: AVX2 has neither compress nor mask registers, and an AVX2 walk, tried, was
- * slower than the scalar one). All versions write exactly the same results;
- * the SIMD compactions may write up to 16 slots past the returned count, so `out` needs 16
- * spare slots.
+ * loops there: AVX2 has neither compress nor mask registers; an AVX2 partition, tried, was
+ * no faster and an AVX2 walk slower than the scalar loops). All versions write exactly the
+ * same results; the SIMD compactions may write up to 16 slots past the returned count, so
+ * `out` needs 16 spare slots.
  *
  * The SIMD versions are compiled where BOXTREES_X86_SIMD is defined: by GCC or clang for
  * x86-64 Linux (and other ELF systems), through per-function target attributes (no -mavx*
