@@ -49,7 +49,9 @@ cdef enum TestKind:
 TEST_KINDS = {"random": RANDOM, "fixed": FIXED, "bounded": BOUNDED, "classic": CLASSIC}
 
 cdef enum:
-    SHORT_SEGMENT = 160  # segments up to this long are scanned whole instead of searched
+    # segments up to this long are scanned whole instead of searched: with SIMD kernels, and
+    SHORT_SEGMENT = 160
+    SHORT_SEGMENT_SCALAR = 16  # with the portable ones (measured best for each)
     SIMD_SLACK = 16  # spare slots the SIMD compactions may write past their count
     TEST_CHUNK = 256  # tests on a feature matrix drawn, then scored column by column,
     TEST_BLOCK = 4    # this many in one pass over the column's values
@@ -61,7 +63,8 @@ cdef double TIE_TOLERANCE = 1e-11
 cdef double FEATURE_THRESHOLD = 1e-7
 
 # the data-parallel kernels used by every tree (see _simd.h)
-cdef boxtrees_kernels _kernels = boxtrees_select_kernels(16)
+cdef boxtrees_kernels _kernels
+cdef intp_t _short_segment  # SHORT_SEGMENT or SHORT_SEGMENT_SCALAR, after the kernels
 
 
 def _set_simd(int max_lanes=16):
@@ -71,9 +74,13 @@ def _set_simd(int max_lanes=16):
     identical results; this switch exists to test that. Returns the lanes of the kernels
     now in use.
     """
-    global _kernels
+    global _kernels, _short_segment
     _kernels = boxtrees_select_kernels(max_lanes)
+    _short_segment = SHORT_SEGMENT if _kernels.lanes > 1 else SHORT_SEGMENT_SCALAR
     return _kernels.lanes
+
+
+_set_simd()
 
 
 def _sort_candidates(const coord_t[::1] keys, const int32[::1] ids):
@@ -584,11 +591,11 @@ cdef class _ObjectSplitter(_Splitter):
             if more_columns:
                 # every column of the box is read, object by object, in the x strip
                 a, e = self.lo[g], self.hi[g]
-                if e - a > SHORT_SEGMENT:
+                if e - a > _short_segment:
                     _strip(xs, self.lo[g], self.hi[g], t.xmin, t.xmax, &a, &e)
                 n = self._compact_columns(t, a, e)
                 inside = strip
-            elif self.hi[g] - self.lo[g] <= SHORT_SEGMENT:
+            elif self.hi[g] - self.lo[g] <= _short_segment:
                 # a short segment is tested whole, x and y at once: no search
                 n = _kernels.compact_box(xs + self.lo[g], ys + self.lo[g], sid + self.lo[g],
                                          self.hi[g] - self.lo[g], t.xmin, t.xmax, ymin, ymax,
