@@ -25,7 +25,8 @@ from ._envs import (_check_env, _close_built, _evaluation_vector, _make_vector, 
 from ._evaluate import _eval_seeds, evaluate
 from ._logger import CSVLogger, _KeyValueLogger
 from ._observations import _ObjectRows, _observation_format
-from ._q_function import _check_leaf_means, _checked_prediction, _QFunction
+from ._q_function import (_check_leaf_means, _checked_prediction, _DoubleQFunction,
+                          _QFunction)
 from ._saving import _read_save, _write_save
 from ._typing import Callback, Dataset, EnvLike, Logger, Observation, Regressor
 
@@ -150,6 +151,15 @@ class FQI:
         `boxtrees.BoxExtraTreesRegressor` with ``bootstrap=False`` (a bootstrap sample
         weighs the leaf means). Memory: one leaf id per transition and tree, and per next
         state, tree and action.
+    double : bool, default=False
+        Double FQI (D'Eramo, Nuara, Pirotta and Restelli, "Estimating the Maximum Expected
+        Value in Continuous Reinforcement Learning Problems", 2017): each iteration splits
+        the data set at random into two halves and fits a Q-function on each (twice the
+        regressors, each on half the data); a transition of one half bootstraps on the
+        other half's value of the action its own half's Q-function rates best, which
+        removes the upward bias of ``max_a Q(s', a)`` over fitting errors. Actions follow
+        the mean of the two. With `leaf_backups` each half's leaves hold the means of its
+        own half's targets.
     n_envs : int, default=None
         Envs played side by side while collecting; None: the vector env's own number, or
         16 for any other env form.
@@ -238,7 +248,7 @@ class FQI:
                  exploration_fraction: float = 0.1, exploration_initial_eps: float = 1.0,
                  exploration_final_eps: float = 0.05,
                  exploration_zeta: float | None = None, tie_break: str = "random",
-                 leaf_backups: int = 0, n_envs: int | None = None,
+                 leaf_backups: int = 0, double: bool = False, n_envs: int | None = None,
                  eval_episodes: int | None = None, eval_seeds: Sequence[int] | None = None,
                  eval_env: EnvLike | None = None, n_jobs: int = 1,
                  log_path: str | os.PathLike[str] | None = None, seed: int | None = None,
@@ -251,7 +261,7 @@ class FQI:
         # None until set_env (below) sets them: afterwards always the env's spaces
         self.observation_space = self.action_space = None  # type: ignore[assignment]
         self.exploration_rate = self.exploration_initial_eps
-        self._q = None  # the last iteration's _QFunction
+        self._q = None  # the last iteration's _QFunction (_DoubleQFunction if double)
         self.history = []
         self.num_timesteps = 0
         self.iteration = 0
@@ -295,6 +305,7 @@ class FQI:
             raise TypeError(f"leaf_backups needs a regressor with an apply method (the leaf of "
                             f"each sample in each tree, as scikit-learn's forests have); "
                             f"{type(regressor).__name__} has none")
+        self.double = _check_bool("double", params["double"])
         self.samples_per_iteration = _check_int("samples_per_iteration",
                                                 params["samples_per_iteration"], 1)
         resample_every = params["resample_every"]
@@ -585,11 +596,15 @@ class FQI:
         times = {}
         with _timed(times, "t_collect"):
             new, collect_reward = self._collect(n_samples)
+        # Double FQI's halves, drawn anew each iteration (only then: other runs' draws stay)
+        split = self._fit_rng.random(len(self._data)) < 0.5 if self.double else None
         with _timed(times, "t_targets"):
-            targets = self._targets(self._data)
+            targets = self._targets(self._data, split)
         with _timed(times, "t_fit"):
-            self._q = _QFunction.fit(self.regressor, self._data, targets, self.n_actions,
-                                     self._fit_rng, self._q, self.iteration)
+            args = (self.regressor, self._data, targets, self.n_actions, self._fit_rng,
+                    self._q, self.iteration)
+            self._q = (_DoubleQFunction.fit(*args, split) if self.double
+                       else _QFunction.fit(*args))
         with _timed(times, "t_evaluate"):
             result = (evaluate(self, self._eval_env, seeds=self._eval_seeds)
                       if self._eval_seeds else None)
@@ -625,18 +640,20 @@ class FQI:
         self._data = batch
         return new
 
-    def _targets(self, data):
+    def _targets(self, data, split):
         """``r`` before any fit, then ``r + gamma * max_a Q_{n-1}(s', a)`` (no bootstrap
-        after a termination), then `leaf_backups` backups on ``Q_{n-1}``'s trees."""
+        after a termination; Double FQI's crossed value, halves `split`), then
+        `leaf_backups` backups on ``Q_{n-1}``'s trees."""
         targets = data.rewards.copy()
         if self._q is not None:
-            future = data.next_values  # known when the data was just collected with Q_{n-1}
+            # known when the data was just collected with Q_{n-1}; not Double FQI's values
+            future = None if self.double else data.next_values
             if future is None:
-                future = self._q_values(data.next_states).max(axis=1)
+                future = self._q.future(data, self.n_jobs, split)
             discounts = np.where(data.terminated, 0.0, self.gamma)
             targets += discounts * future
             if self.leaf_backups:
-                targets = self._q.backups(data, targets, discounts, self.leaf_backups)
+                targets = self._q.backups(data, targets, discounts, self.leaf_backups, split)
         data.next_values = None  # stale once Q_n is fitted
         return targets
 
@@ -722,7 +739,8 @@ class FQI:
 
     @property
     def q_functions_(self) -> list[Regressor] | None:
-        """The fitted ``Q_n``, one regressor per action (None before the first iteration)."""
+        """The fitted ``Q_n``, one regressor per action (None before the first iteration);
+        with `double`, the first half's then the second half's: ``2 * n_actions``."""
         return None if self._q is None else self._q.models
 
     def predict(self, observation: Observation, state: object = None,

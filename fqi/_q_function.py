@@ -48,7 +48,12 @@ class _QFunction:
             models.append(model.fit(data.states[mask], targets[mask]))
         return cls(models, iteration)
 
-    def backups(self, data, targets, discounts, n_backups):
+    def future(self, data, n_jobs=1, split=None):
+        """``max_a Q(s', a)`` for the next state of every transition of `data` (`split` is
+        `_DoubleQFunction`'s; unused here)."""
+        return self.values(data.next_states, n_jobs).max(axis=1)
+
+    def backups(self, data, targets, discounts, n_backups, split=None):
         """`targets` after `n_backups` fitted-Q backups that keep these models' trees.
 
         Each backup sets every leaf's value to the mean target of the transitions of the
@@ -67,19 +72,26 @@ class _QFunction:
         discounts : ndarray of shape (len(data),)
             ``gamma``, or 0 after a termination.
         n_backups : int
+        split : None
+            `_DoubleQFunction`'s; unused here.
 
         Returns
         -------
         targets : ndarray of shape (len(data),)
         """
-        tables = [_LeafTable(model, data.states[data.actions == action], data.next_states)
-                  for action, model in enumerate(self.models)]
-        q = np.empty((len(data), len(self.models)))
+        rows = np.ones(len(data), dtype=bool)
+        tables = self._leaf_tables(data, rows)
         for _ in range(n_backups):
-            for action, table in enumerate(tables):
-                q[:, action] = table.next_values(targets[data.actions == action])
+            q = _leaf_values(tables, targets, data.actions, rows)
             targets = data.rewards + discounts * q.max(axis=1)
         return targets
+
+    def _leaf_tables(self, data, rows):
+        """A `_LeafTable` per action: where the transitions of `rows` (a mask of `data`)
+        with that action, and every next state of `data`, fall in that action's trees."""
+        return [_LeafTable(model, data.states[rows & (data.actions == action)],
+                           data.next_states)
+                for action, model in enumerate(self.models)]
 
     def values(self, batch, n_jobs=1):
         """``Q(s, a)`` of every action for the observations of `batch`, shape ``(n,
@@ -97,6 +109,82 @@ class _QFunction:
                 prediction, len(batch), lambda: f"iteration {self.iteration}'s Q-function of "
                 f"action {action} ({self.models[action]!r})")
         return q
+
+
+class _DoubleQFunction:
+    """Double FQI's ``Q_n`` (D'Eramo, Nuara, Pirotta and Restelli, 2017): two `_QFunction`,
+    each fitted on its own half of the data set, that select and evaluate the next
+    action for each other's half.
+
+    A single Q-function's ``max_a Q(s', a)`` is biased upwards: the action that looks best
+    is often the one whose fit erred upwards. Here a transition of half ``i`` bootstraps on
+    ``Q^j(s', argmax_a Q^i(s', a))``, ``j`` the other half, whose errors at ``s'`` are
+    independent of those that chose the action. Actions follow the mean of the two.
+
+    Parameters
+    ----------
+    halves : list of two _QFunction
+    """
+
+    def __init__(self, halves):
+        self.halves = halves
+
+    @property
+    def models(self):
+        """The regressors of the first half, one per action, then those of the second."""
+        return [model for half in self.halves for model in half.models]
+
+    @property
+    def iteration(self):
+        return self.halves[0].iteration
+
+    @classmethod
+    def fit(cls, regressor, data, targets, n_actions, rng, previous, iteration, split):
+        """`_QFunction.fit` on each half: the transitions of `split` (a mask of `data`),
+        then the others; `previous` is the last `_DoubleQFunction`, or None."""
+        return cls([_QFunction.fit(regressor, data[rows], targets[rows], n_actions, rng,
+                                   None if previous is None else previous.halves[half],
+                                   iteration)
+                    for half, rows in enumerate((split, ~split))])
+
+    def values(self, batch, n_jobs=1):
+        """The mean of the two halves' ``Q(s, a)`` (see `_QFunction.values`)."""
+        first, second = (half.values(batch, n_jobs) for half in self.halves)
+        return (first + second) / 2
+
+    def future(self, data, n_jobs=1, split=None):
+        """Each transition's bootstrap value: the action chosen by the Q-function of its
+        half (`split`: the transitions of the first), valued by the other's."""
+        first, second = (half.values(data.next_states, n_jobs) for half in self.halves)
+        return _crossed(first, second, split)
+
+    def backups(self, data, targets, discounts, n_backups, split=None):
+        """`_QFunction.backups`, each half's leaves holding the mean targets of its own
+        transitions, and the bootstrap values crossed as in `future`."""
+        halves = [(half, rows, half._leaf_tables(data, rows))
+                  for half, rows in zip(self.halves, (split, ~split))]
+        for _ in range(n_backups):
+            first, second = (_leaf_values(tables, targets, data.actions, rows)
+                             for _, rows, tables in halves)
+            targets = data.rewards + discounts * _crossed(first, second, split)
+        return targets
+
+
+def _crossed(first, second, split):
+    """Double Q-learning's values: where `split`, ``second`` at ``first``'s best action;
+    elsewhere ``first`` at ``second``'s best action."""
+    rows = np.arange(len(first))
+    return np.where(split, second[rows, first.argmax(axis=1)],
+                    first[rows, second.argmax(axis=1)])
+
+
+def _leaf_values(tables, targets, actions, rows):
+    """``Q(s', a)`` of every next state and action, from the per-action `tables` whose
+    leaves hold the mean of `targets` over the transitions of `rows` with that action."""
+    q = np.empty((tables[0].n_next, len(tables)))
+    for action, table in enumerate(tables):
+        q[:, action] = table.next_values(targets[rows & (actions == action)])
+    return q
 
 
 def _checked_prediction(prediction, n, describe):
@@ -139,6 +227,11 @@ class _LeafTable:
         self._counts = np.maximum(counts, 1)
         self._alone = np.flatnonzero(self._n_reached == 0)  # reaches no leaf with data
         self._own = model.predict(next_states[self._alone]) if len(self._alone) else None
+
+    @property
+    def n_next(self):
+        """Number of next states."""
+        return len(self._next)
 
     def next_values(self, targets):
         """``Q(s', a)`` for every next state, the leaves holding the mean of `targets` (one

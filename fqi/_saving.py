@@ -6,7 +6,8 @@ import joblib
 
 __all__ = []
 
-_SAVE_FORMAT = 5  # 3: the exploration schedule replaced epsilon; 4: tie_break; 5: leaf_backups
+_SAVE_FORMAT = 6  # 3: exploration schedule, not epsilon; 4: tie_break; 5: leaf_backups;
+#                   6: double
 
 
 def _write_save(state, path):

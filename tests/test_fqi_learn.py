@@ -101,10 +101,10 @@ def test_leaf_backups_carry_value_further_per_fit():
     agent = cartpole_agent(leaf_backups=3, gamma=0.5)
     agent.n_actions = 1
     agent._q = _QFunction.fit(tree, data, chain, 1, np.random.default_rng(0), None, 0)
-    targets = agent._targets(data)  # r (Q_{n-1} = 0 on the next states), then 3 backups
+    targets = agent._targets(data, None)  # r (Q_{n-1} = 0 on the next states), then 3 backups
     assert targets[:6].tolist() == [0.0, 0.0, 0.125, 0.25, 0.5, 1.0]
     agent.leaf_backups, data.next_values = 0, np.zeros(n)
-    assert agent._targets(data)[:6].tolist() == [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    assert agent._targets(data, None)[:6].tolist() == [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
 
 
 @pytest.mark.parametrize("regressor, error, match", [
