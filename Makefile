@@ -17,7 +17,7 @@ bench: $(VENV)/.installed
 	$(PY) -m benchmarks.run_all --quick --jobs 2
 
 test: $(VENV)/.installed
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q -n auto --dist loadfile tests
 
 install: $(VENV)/.installed
 

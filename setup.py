@@ -7,7 +7,11 @@ only by GCC or clang targeting x86-64 outside macOS and Windows (so on Linux), a
 when the CPU has AVX2 or AVX-512F (checked at import); builds with MSVC, for macOS (either
 architecture) or for ARM have the portable kernels alone. The inner loops are written so
 that the compiler can vectorise them at the baseline instruction set.
+
+``BOXTREES_OPTIMIZE`` (default ``-O3``) replaces the optimisation flag of GCC and clang: the
+AddressSanitizer test builds with ``-O1``, which compiles in half the time.
 """
+import os
 import sys
 
 import numpy as np
@@ -15,7 +19,8 @@ from Cython.Build import cythonize
 from setuptools import Extension, setup
 
 # GCC and clang; MSVC keeps setuptools' own optimisation flag (/O2)
-compile_args = [] if sys.platform == "win32" else ["-O3", "-fno-math-errno"]
+compile_args = ([] if sys.platform == "win32"
+                else [os.environ.get("BOXTREES_OPTIMIZE", "-O3"), "-fno-math-errno"])
 
 
 def _extension(name):

@@ -43,12 +43,25 @@ THESIS_TREE = dict(test_type="fixed", test_width=1.0, relative_width=False, refi
 THESIS_FOREST = dict(THESIS_TREE, bootstrap=False)
 
 
-
 @pytest.fixture(scope="session")
 def tiny_run(tmp_path_factory):
     """Every default experiment of the reproduction run at the tiny budget, once for all the
-    tests (tests/benchmarks/): its output folder and report."""
+    tests (tests/benchmarks/): its output folder and report. Under pytest-xdist the first
+    worker to ask runs it into the workers' common folder, and each worker gets its own copy
+    (some tests delete and rerun runs of it)."""
     from benchmarks.reproduce.cli import main
 
     out = tmp_path_factory.mktemp("run_all")
-    return out, main(["--budget", "tiny", "--out", str(out), "--no-progress"])
+    if "PYTEST_XDIST_WORKER" not in os.environ:
+        return out, main(["--budget", "tiny", "--out", str(out), "--no-progress"])
+    import shutil
+
+    from filelock import FileLock
+
+    shared = tmp_path_factory.getbasetemp().parent / "run_all"
+    with FileLock(f"{shared}.lock"):
+        if not (shared / "REPORT.md").is_file():  # written last, so the run is whole
+            shutil.rmtree(shared, ignore_errors=True)
+            main(["--budget", "tiny", "--out", str(shared), "--no-progress"])
+    shutil.copytree(shared, out, dirs_exist_ok=True)
+    return out, out / "REPORT.md"
