@@ -16,8 +16,10 @@ TORCH_INDEX := https://download.pytorch.org/whl/cpu
 bench: $(VENV)/.installed
 	$(PY) -m benchmarks.run_all --quick --jobs 2
 
+# a test file per worker, handed out in collection order: the few long files (the games,
+# the sanitizer build) start early instead of after xdist's largest-first order
 test: $(VENV)/.installed
-	$(PY) -m pytest -q -n auto --dist loadfile tests
+	$(PY) -m pytest -q -n auto --dist loadfile --no-loadscope-reorder tests
 
 install: $(VENV)/.installed
 

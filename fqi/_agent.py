@@ -811,7 +811,8 @@ class FQI:
             Constructor parameters to change (``log_path``, ``n_jobs``, ``eval_seeds``...),
             checked as by the constructor; the others keep their saved values (a saved
             ``log_path`` too: further iterations append to that CSV; pass
-            ``log_path=None`` to log nowhere).
+            ``log_path=None`` to log nowhere). ``double`` changes only on an agent that
+            has no Q-function yet (ValueError otherwise).
 
         Returns
         -------
@@ -827,6 +828,9 @@ class FQI:
         agent = cls.__new__(cls)
         agent.__dict__.update({k: v for k, v in state.items() if k not in names})
         agent._set_params({**{name: state[name] for name in names}, **params})
+        if agent._q is not None and agent.double != state["double"]:
+            raise ValueError(f"double cannot change once the agent has a Q-function: {path} "
+                             f"holds a {'Double ' if state['double'] else ''}FQI agent's")
         agent._env = agent._eval_env = agent._collector = agent._held = None
         agent._data = agent._logger = None
         env = agent.env if env is None else env

@@ -95,6 +95,11 @@ def test_double_fqi_learns_cartpole(tmp_path):
     assert loaded.double is True
     obs = np.random.default_rng(0).normal(size=(50, 4))
     np.testing.assert_array_equal(loaded.q_values(obs), agent.q_values(obs))
+    with pytest.raises(ValueError, match="double cannot change once the agent has a Q-f"):
+        FQI.load(tmp_path / "agent.joblib", double=False)
+    unfitted = _agent(double=False)
+    unfitted.save(tmp_path / "unfitted.joblib")
+    assert FQI.load(tmp_path / "unfitted.joblib", double=True).double is True
 
 
 @pytest.mark.parametrize("leaf_backups", [0, 3])
