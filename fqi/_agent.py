@@ -122,8 +122,8 @@ class FQI:
         random whatever they are: there is no Q-function yet.
     exploration_zeta : float or None, default=None
         None: each random action lasts one step (epsilon-greedy). A number ``mu > 1``:
-        temporally-extended epsilon-greedy ("ez-greedy", Dabney, Ostrovski and Barreto,
-        2021): an env that is not holding an action starts, with the probability of a random
+        temporally-extended epsilon-greedy ("ez-greedy", "Temporally-Extended
+        epsilon-Greedy Exploration", ICLR 2021): an env that is not holding an action starts, with the probability of a random
         action, to hold a uniformly drawn action for ``n`` steps, ``n`` drawn from the zeta
         distribution of exponent ``mu`` (``P(n) ~ n**-mu``: mostly short, sometimes long;
         capped at 10,000 steps; a hold may run on into the env's next episode), and acts
@@ -152,8 +152,8 @@ class FQI:
         weighs the leaf means). Memory: one leaf id per transition and tree, and per next
         state, tree and action.
     double : bool, default=False
-        Double FQI (D'Eramo, Nuara, Pirotta and Restelli, "Estimating the Maximum Expected
-        Value in Continuous Reinforcement Learning Problems", 2017): each iteration splits
+        Double FQI ("Estimating the Maximum Expected Value in Continuous Reinforcement
+        Learning Problems", AAAI 2017): each iteration splits
         the data set at random into two halves and fits a Q-function on each (twice the
         regressors, each on half the data); a transition of one half bootstraps on the
         other half's value of the action its own half's Q-function rates best, which

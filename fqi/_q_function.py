@@ -112,9 +112,9 @@ class _QFunction:
 
 
 class _DoubleQFunction:
-    """Double FQI's ``Q_n`` (D'Eramo, Nuara, Pirotta and Restelli, 2017): two `_QFunction`,
-    each fitted on its own half of the data set, that select and evaluate the next
-    action for each other's half.
+    """Double FQI's ``Q_n`` ("Estimating the Maximum Expected Value in Continuous
+    Reinforcement Learning Problems", AAAI 2017): two `_QFunction`, each fitted on its own
+    half of the data set, that select and evaluate the next action for each other's half.
 
     A single Q-function's ``max_a Q(s', a)`` is biased upwards: the action that looks best
     is often the one whose fit erred upwards. Here a transition of half ``i`` bootstraps on
