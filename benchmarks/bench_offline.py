@@ -387,15 +387,18 @@ def run_key(dataset, method, seed, budget, n_transitions):
     return f"{dataset}_{method}_seed{seed}_{n_transitions}_{budget}"
 
 
-def run_part(args, methods, budget, train):
-    """Each run of `methods` x data sets x ``args.seeds`` not already in ``args.out/runs``
-    from the same data: trained with ``train(data, method, seed, key)`` and saved there."""
+def run_part(args, methods, budget, train, datasets=DATASETS):
+    """Each run of `methods` x `datasets` x ``args.seeds`` not already in ``args.out/runs``
+    from the same data: trained with ``train(data, method, seed, key)`` and saved there.
+    Returns the paths of the runs, in that order."""
     info = read_info(args.data)
-    plan = [(name, method, seed) for name in DATASETS for method in methods
+    plan = [(name, method, seed) for name in datasets for method in methods
             for seed in args.seeds]
+    paths = []
     for name, method, seed in tqdm(plan, desc=" and ".join(methods)):
         key = run_key(name, method, seed, budget, args.transitions)
         path = args.out / "runs" / f"{key}.json"
+        paths.append(path)
         digest = info["datasets"][name]["sha256"]
         if path.exists() and json.loads(path.read_text())["data_sha256"] == digest:
             continue
@@ -410,6 +413,7 @@ def run_part(args, methods, budget, train):
         tqdm.write(f"{name:<7} {method:<11} seed {seed}: {record['train_seconds']:7.1f} s"
                    + ("" if record["mean_return"] is None
                       else f", mean return {record['mean_return']:6.1f}"))
+    return paths
 
 
 def read_info(data_dir):
@@ -577,7 +581,7 @@ def report_part(args):
     summary = summarise(runs)
     table = markdown(summary, info)
     print(table)
-    report = {"benchmark": "bench_offline", "args": _jsonable(vars(args)), "env": ENV_ID,
+    report = {"benchmark": "bench_offline", "args": jsonable(vars(args)), "env": ENV_ID,
               "gamma": GAMMA, "eval_episodes": EVAL_EPISODES, "data": info,
               "methods": {"fqi": {m: repr(make_regressor(n)) for m, n in FQI_METHODS.items()},
                           "d3rlpy": D3RLPY_METHODS},
@@ -589,7 +593,8 @@ def report_part(args):
     print(f"wrote {args.out / 'bench_offline.json'} and {args.out / 'bench_offline.png'}")
 
 
-def _jsonable(arguments):
+def jsonable(arguments):
+    """Command-line arguments as JSON values (paths as strings)."""
     return {key: str(value) if isinstance(value, Path) else value
             for key, value in arguments.items()}
 
@@ -611,14 +616,21 @@ def parse_args(argv=None):
     parser.add_argument("--out", type=Path, default=Path("results/offline"))
     parser.add_argument("--data", type=Path, default=Path("results/offline-data"),
                         help="folder of the data sets (.npz) and the d3rlpy policies")
-    args = parser.parse_args(argv)
+    return sized_args(parser, parser.parse_args(argv), QUICK,
+                      {"transitions": 1, "iterations": 1, "gradient_steps": 1})
+
+
+def sized_args(parser, args, quick, minimums):
+    """`args` with the medium behaviour's training steps, `quick`'s sizes under ``--quick``,
+    and each size of `minimums` checked to be at least its value (else the parser's error)."""
     args.medium_training_steps = MEDIUM_TRAINING_STEPS
     if args.quick:
-        for key, value in QUICK.items():
+        for key, value in quick.items():
             setattr(args, key, value)
-    for name in ("transitions", "iterations", "gradient_steps"):
-        if getattr(args, name) < 1:
-            parser.error(f"--{name.replace('_', '-')} must be >= 1, got {getattr(args, name)}")
+    for name, minimum in minimums.items():
+        if getattr(args, name) < minimum:
+            parser.error(f"--{name.replace('_', '-')} must be >= {minimum}, got "
+                         f"{getattr(args, name)}")
     return args
 
 

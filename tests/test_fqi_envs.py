@@ -449,6 +449,30 @@ def test_stable_baselines3_eval_callback_and_logger():
         agent.set_logger(print)
 
 
+@pytest.mark.filterwarnings("ignore:Training and eval env are not of the same type")
+def test_stable_baselines3_stopping_callbacks_end_learn(tmp_path):
+    """SB3's way to stop early works as it does with DQN: an EvalCallback every 2 iterations
+    whose new best passes a reward threshold stops training at that evaluation, and the
+    best agent it saved loads."""
+    from stable_baselines3.common.callbacks import EvalCallback, StopTrainingOnRewardThreshold
+
+    agent = FQI(classic_forest(), "CartPole-v1", samples_per_iteration=100, eval_episodes=0,
+                seed=0)
+    threshold = StopTrainingOnRewardThreshold(reward_threshold=1, verbose=0)
+    evaluation = EvalCallback(gym.make("CartPole-v1"), eval_freq=2, n_eval_episodes=2,
+                              callback_on_new_best=threshold, best_model_save_path=tmp_path,
+                              warn=False, verbose=0)
+    agent.learn(n_iterations=6, callback=evaluation)
+    assert agent.iteration == 2 and evaluation.best_mean_reward >= 8
+    best = FQI.load(tmp_path / "best_model", env="CartPole-v1")
+    assert best.iteration == 2 and best.num_timesteps == agent.num_timesteps
+    unreachable = StopTrainingOnRewardThreshold(reward_threshold=501, verbose=0)
+    agent.learn(n_iterations=3, callback=EvalCallback(
+        gym.make("CartPole-v1"), eval_freq=1, n_eval_episodes=2,
+        callback_on_new_best=unreachable, warn=False, verbose=0))
+    assert agent.iteration == 5
+
+
 class Closing(Countdown):
     """Counts the `close` calls of its instances."""
 
