@@ -300,15 +300,18 @@ cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_obje
     cdef const float64_t* value = forest.value
     cdef intp_t n_trees = forest.n_trees, n_outputs = forest.n_outputs
     cdef intp_t block = 0, block_end, tree, i, k, leaf
+    cdef intp_t block_leaves[BLOCK]
     while block < n_samples:
         block_end = min(block + <intp_t>BLOCK, n_samples)
         if mean != NULL:
             for i in range(block * n_outputs, block_end * n_outputs):
                 mean[i] = 0.0
         for tree in range(n_trees):
+            _kernels.find_leaves(nodes + tree_offsets[tree], forest.extras, features, n_objects,
+                                 type_ptr + block * stride, stride, block_end - block,
+                                 block_leaves)
             for i in range(block, block_end):
-                leaf = _kernels.find_leaf(nodes + tree_offsets[tree], forest.extras, features,
-                                          n_objects, type_ptr + i * stride)
+                leaf = block_leaves[i - block]
                 if mean == NULL:
                     leaves[i * n_trees + tree] = leaf
                     continue

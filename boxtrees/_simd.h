@@ -7,8 +7,9 @@
  *   attributes are read in the objects' attribute rows;
  * - partition: renumber a run's sample ids and move, stably, the objects of the left child's
  *   samples (new id < mid) before those of the right child's;
- * - find_leaf: walk one sample down one tree (the AVX-512 version tests up to sixteen of the
- *   sample's objects of a type at once, with no loop to mispredict).
+ * - find_leaves: walk samples down one tree (the AVX-512 version tests up to sixteen of a
+ *   sample's objects of a type at once, with no loop to mispredict, and walks
+ *   BOXTREES_WALKS samples side by side).
  *
  * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
  * run time, so the default build stays portable) sixteen objects are handled per step; with
@@ -74,18 +75,23 @@ typedef struct {
     float high;
 } boxtrees_extra;
 
-/* The tree-local leaf a sample reaches from root `nodes`; attribute c of its objects of type t
-   is features[c * stride + types[t]] to features[c * stride + types[t + 1] - 1]. */
-typedef int64_t (*boxtrees_find_leaf_fn)(const boxtrees_node *nodes,
-                                         const boxtrees_extra *extras, const float *features,
-                                         int64_t stride, const int64_t *types);
+/* The tree-local leaves that n_samples samples reach from root `nodes`, into out[i]: attribute
+   c of sample i's objects of type t is features[c * stride + ts[t]] to
+   features[c * stride + ts[t + 1] - 1], ts = types + i * types_stride. */
+typedef void (*boxtrees_find_leaves_fn)(const boxtrees_node *nodes,
+                                        const boxtrees_extra *extras, const float *features,
+                                        int64_t stride, const int64_t *types,
+                                        int64_t types_stride, int64_t n_samples, int64_t *out);
+
+/* Samples walked side by side by the AVX-512 find_leaves. */
+#define BOXTREES_WALKS 2
 
 typedef struct {
     boxtrees_compact_fn compact;
     boxtrees_compact_box_fn compact_box;
     boxtrees_compact_columns_fn compact_columns;
     boxtrees_partition_fn partition;
-    boxtrees_find_leaf_fn find_leaf;
+    boxtrees_find_leaves_fn find_leaves;
     int lanes; /* objects a step: 16 (AVX-512), 8 (AVX2) or 1 (portable) */
 } boxtrees_kernels;
 
@@ -222,6 +228,18 @@ static int64_t boxtrees_find_leaf_portable(const boxtrees_node *nodes,
         n = nodes + (count < n->threshold ? n->left : n->right);
     }
     return n - nodes;
+}
+
+/* The leaves of `n_samples` samples in one tree: sample i's type offsets start at
+   types + i * types_stride, its leaf goes to out[i]. */
+static void boxtrees_find_leaves_portable(const boxtrees_node *nodes,
+                                          const boxtrees_extra *extras, const float *features,
+                                          int64_t stride, const int64_t *types,
+                                          int64_t types_stride, int64_t n_samples, int64_t *out)
+{
+    for (int64_t i = 0; i < n_samples; i++)
+        out[i] = boxtrees_find_leaf_portable(nodes, extras, features, stride,
+                                             types + i * types_stride);
 }
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(__APPLE__) && !defined(_WIN32)
@@ -434,34 +452,76 @@ static int64_t boxtrees_partition_avx512(float *xs, float *ys, int32_t *sid, int
     return boxtrees_partition_finish(xs, ys, sid, nl, nr, tmp_x, tmp_y, tmp_sid);
 }
 
+/* The child of inner node `n` that a sample goes to (up to 16 of its objects of the node's
+   type tested at once). */
+__attribute__((target("avx512f")))
+static inline const boxtrees_node *boxtrees_next_avx512(const boxtrees_node *nodes,
+                                                        const boxtrees_node *n,
+                                                        const boxtrees_extra *extras,
+                                                        const float *features, int64_t stride,
+                                                        const int64_t *types)
+{
+    int32_t count = 0;
+    if (n->extra >= 0) {
+        count = boxtrees_count_extra(n, extras, features, stride, types);
+        return nodes + (count < n->threshold ? n->left : n->right);
+    }
+    const float *x = features + n->x_column * stride, *y = features + n->y_column * stride;
+    int64_t k = types[n->object_type], end = types[n->object_type + 1];
+    do {    /* one pass for up to 16 objects (and for none) */
+        __mmask16 live = end - k >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << (end - k)) - 1u);
+        __m512 xs = _mm512_maskz_loadu_ps(live, x + k), ys = _mm512_maskz_loadu_ps(live, y + k);
+        __mmask16 in = live & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[0]), _CMP_GT_OQ)
+                       & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[1]), _CMP_LT_OQ)
+                       & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[2]), _CMP_GT_OQ)
+                       & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[3]), _CMP_LT_OQ);
+        count += __builtin_popcount((unsigned)in);
+        k += 16;
+    } while (k < end);
+    return nodes + (count < n->threshold ? n->left : n->right);
+}
+
 __attribute__((target("avx512f")))
 static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes,
                                          const boxtrees_extra *extras, const float *features,
                                          int64_t stride, const int64_t *types)
 {
     const boxtrees_node *n = nodes;
-    while (n->left != -1) {
-        const float *x = features + n->x_column * stride, *y = features + n->y_column * stride;
-        int64_t k = types[n->object_type], end = types[n->object_type + 1];
-        int32_t count = 0;
-        if (n->extra >= 0) {
-            count = boxtrees_count_extra(n, extras, features, stride, types);
-            n = nodes + (count < n->threshold ? n->left : n->right);
-            continue;
-        }
-        do {    /* one pass for up to 16 objects (and for none) */
-            __mmask16 live = end - k >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << (end - k)) - 1u);
-            __m512 xs = _mm512_maskz_loadu_ps(live, x + k), ys = _mm512_maskz_loadu_ps(live, y + k);
-            __mmask16 in = live & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[0]), _CMP_GT_OQ)
-                           & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[1]), _CMP_LT_OQ)
-                           & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[2]), _CMP_GT_OQ)
-                           & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[3]), _CMP_LT_OQ);
-            count += __builtin_popcount((unsigned)in);
-            k += 16;
-        } while (k < end);
-        n = nodes + (count < n->threshold ? n->left : n->right);
-    }
+    while (n->left != -1)
+        n = boxtrees_next_avx512(nodes, n, extras, features, stride, types);
     return n - nodes;
+}
+
+/* BOXTREES_WALKS samples at a time, one step each in turn until all are at their leaves:
+   the walks are independent, so the CPU overlaps one's loads with another's tests, where a
+   single walk waits for each node before it can read the next. */
+__attribute__((target("avx512f")))
+static void boxtrees_find_leaves_avx512(const boxtrees_node *nodes,
+                                        const boxtrees_extra *extras, const float *features,
+                                        int64_t stride, const int64_t *types,
+                                        int64_t types_stride, int64_t n_samples, int64_t *out)
+{
+    int64_t i = 0;
+    for (; i + BOXTREES_WALKS <= n_samples; i += BOXTREES_WALKS) {
+        const boxtrees_node *at[BOXTREES_WALKS];
+        for (int w = 0; w < BOXTREES_WALKS; w++)
+            at[w] = nodes;
+        int walking;
+        do {
+            walking = 0;
+            for (int w = 0; w < BOXTREES_WALKS; w++)
+                if (at[w]->left != -1) {
+                    at[w] = boxtrees_next_avx512(nodes, at[w], extras, features, stride,
+                                                 types + (i + w) * types_stride);
+                    walking = 1;
+                }
+        } while (walking);
+        for (int w = 0; w < BOXTREES_WALKS; w++)
+            out[i + w] = at[w] - nodes;
+    }
+    for (; i < n_samples; i++)
+        out[i] = boxtrees_find_leaf_avx512(nodes, extras, features, stride,
+                                           types + i * types_stride);
 }
 #endif
 
@@ -472,7 +532,7 @@ static inline boxtrees_kernels boxtrees_select_kernels(int max_lanes)
 {
     boxtrees_kernels k = {boxtrees_compact_portable, boxtrees_compact_box_portable,
                           boxtrees_compact_columns_portable, boxtrees_partition_portable,
-                          boxtrees_find_leaf_portable, 1};
+                          boxtrees_find_leaves_portable, 1};
 #ifdef BOXTREES_X86_SIMD
     __builtin_cpu_init();
     if (max_lanes >= 16 && __builtin_cpu_supports("avx512f")) {
@@ -480,7 +540,7 @@ static inline boxtrees_kernels boxtrees_select_kernels(int max_lanes)
         k.compact_box = boxtrees_compact_box_avx512;
         k.compact_columns = boxtrees_compact_columns_avx512;
         k.partition = boxtrees_partition_avx512;
-        k.find_leaf = boxtrees_find_leaf_avx512;
+        k.find_leaves = boxtrees_find_leaves_avx512;
         k.lanes = 16;
     } else if (max_lanes >= 8 && __builtin_cpu_supports("avx2")
                && __builtin_cpu_supports("popcnt")) {

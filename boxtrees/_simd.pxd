@@ -19,8 +19,8 @@ cdef extern from "_simd.h":
         intp_t (*partition)(coord_t* xs, coord_t* ys, int32* sid, intp_t n,
                             const int32* new_id, int32 mid, coord_t* tmp_x, coord_t* tmp_y,
                             int32* tmp_sid) noexcept nogil
-        intp_t (*find_leaf)(const boxtrees_node* nodes, const boxtrees_extra* extras,
-                            const coord_t* features, intp_t stride,
-                            const intp_t* types) noexcept nogil
+        void (*find_leaves)(const boxtrees_node* nodes, const boxtrees_extra* extras,
+                            const coord_t* features, intp_t stride, const intp_t* types,
+                            intp_t types_stride, intp_t n_samples, intp_t* out) noexcept nogil
         int lanes
     boxtrees_kernels boxtrees_select_kernels(int max_lanes) noexcept nogil
