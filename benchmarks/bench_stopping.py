@@ -29,7 +29,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from benchmarks import bench_offline
 
