@@ -127,3 +127,19 @@ def test_an_agent_loaded_without_an_env_needs_one_to_evaluate(tmp_path):
         loaded.learn_offline(data, n_iterations=1)
     assert len(loaded.history) == 1  # unchanged
     FQI.load(tmp_path / "agent.joblib", eval_episodes=0).learn_offline(data, n_iterations=1)
+
+
+@pytest.mark.filterwarnings("ignore:Training and eval env are not of the same type")
+def test_stable_baselines3_evaluation_scores_the_iterates_and_keeps_the_best(tmp_path):
+    """Offline, an SB3 EvalCallback on an env scores the iterates as online: it saves the
+    best one and its threshold stops the backups."""
+    from stable_baselines3.common.callbacks import EvalCallback, StopTrainingOnRewardThreshold
+
+    evaluation = EvalCallback(gym.make("CartPole-v1"), eval_freq=2, n_eval_episodes=2,
+                              best_model_save_path=tmp_path, warn=False, verbose=0,
+                              callback_on_new_best=StopTrainingOnRewardThreshold(
+                                  reward_threshold=1, verbose=0))
+    agent = cartpole().learn_offline(random_transitions("CartPole-v1", 500), n_iterations=6,
+                                     callback=evaluation)
+    assert agent.iteration == 2 and agent.num_timesteps == 0
+    assert FQI.load(tmp_path / "best_model", env="CartPole-v1").iteration == 2
