@@ -261,12 +261,17 @@ def held_out_return(policy):
         env.close()
 
 
-def run_fqi(data, method, seed, n_iterations):
-    """`FQI.learn_offline` on `data`; the record of the run (no file written)."""
+def make_agent(method, seed):
+    """The untrained FQI agent of `method` (one of `FQI_METHODS`), as every run uses it."""
     from fqi import FQI
 
-    agent = FQI(make_regressor(FQI_METHODS[method]), ENV_ID, gamma=GAMMA, n_envs=1,
-                eval_episodes=0, seed=seed)
+    return FQI(make_regressor(FQI_METHODS[method]), ENV_ID, gamma=GAMMA, n_envs=1,
+               eval_episodes=0, seed=seed)
+
+
+def run_fqi(data, method, seed, n_iterations):
+    """`FQI.learn_offline` on `data`; the record of the run (no file written)."""
+    agent = make_agent(method, seed)
     _, seconds, cpu_seconds = timed(agent.learn_offline, data, n_iterations=n_iterations)
     return {"budget": {"iterations": n_iterations}, "train_seconds": seconds,
             "train_cpu_seconds": cpu_seconds, "mean_return": held_out_return(agent),

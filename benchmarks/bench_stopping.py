@@ -40,14 +40,9 @@ SETTLED_FROM = 20
 
 def trace_fqi(data, method, seed, n_iterations):
     """`FQI.learn_offline` on `data`, measured after every backup: one row per iteration."""
-    from fqi import FQI
-
     states = data["observations"]
-    # bench_offline's agent (settings, seed, scoring): a run as long as one of its runs
-    # ends on that run's figure
-    agent = FQI(bench_offline.make_regressor(bench_offline.FQI_METHODS[method]),
-                bench_offline.ENV_ID, gamma=bench_offline.GAMMA, n_envs=1, eval_episodes=0,
-                seed=seed)
+    # bench_offline's agent and scoring: a run as long as one of its runs ends on its figure
+    agent = bench_offline.make_agent(method, seed)
     rows, last, measuring = [], [], np.zeros(2)  # measuring: its wall and CPU seconds
 
     def measure(locals_, globals_):

@@ -9,14 +9,13 @@ from benchmarks import bench_offline, bench_stopping
 
 
 def test_each_backup_is_measured_on_the_data_states():
-    from fqi import FQI, RandomPolicy
+    from fqi import RandomPolicy
 
     data, _ = bench_offline.collect(RandomPolicy("CartPole-v1", seed=0), 600, seed=0, n_envs=2)
     run = bench_stopping.trace_fqi(data, "fqi-nmin10", seed=0, n_iterations=3)
     assert [row["iteration"] for row in run["iterations"]] == [0, 1, 2]
     # the same seeded agents, stopped after 2 and 3 backups, give the measures
-    agents = [FQI(bench_offline.make_regressor(10), "CartPole-v1", gamma=bench_offline.GAMMA,
-                  n_envs=1, eval_episodes=0, seed=0).learn_offline(data, n_iterations=n)
+    agents = [bench_offline.make_agent("fqi-nmin10", seed=0).learn_offline(data, n_iterations=n)
               for n in (2, 3)]
     q = [agent.q_values(data["observations"]) for agent in agents]
     first, _, last = run["iterations"]
