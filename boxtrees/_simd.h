@@ -7,9 +7,10 @@
  *   attributes are read in the objects' attribute rows;
  * - partition: renumber a run's sample ids and move, stably, the objects of the left child's
  *   samples (new id < mid) before those of the right child's;
- * - find_leaves: walk samples down one tree (the AVX-512 version tests up to sixteen of a
- *   sample's objects of a type at once, with no loop to mispredict, and walks
- *   BOXTREES_WALKS samples side by side).
+ * - find_leaves: walk samples down one tree (the AVX-512 version walks BOXTREES_WALKS samples
+ *   of at most sixteen objects side by side, each node testing all of a sample's objects in
+ *   one load and keeping the lanes of the node's type; a larger sample is walked alone, up
+ *   to sixteen of its objects of a type at once).
  *
  * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
  * run time, so the default build stays portable) sixteen objects are handled per step; with
@@ -492,36 +493,95 @@ static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes,
     return n - nodes;
 }
 
-/* BOXTREES_WALKS samples at a time, one step each in turn until all are at their leaves:
-   the walks are independent, so the CPU overlaps one's loads with another's tests, where a
-   single walk waits for each node before it can read the next. */
+/* The child of inner node `n` for a sample of at most 16 objects (of the forest's types):
+   its objects of every type are lanes 0 to popcount(live) - 1 of one load at features + c *
+   stride + base, those of type position t lanes types[t] - base to types[t + 1] - base. The
+   loads depend on the node alone, not on the sample's type offsets, which only pick lanes. */
+__attribute__((target("avx512f")))
+static inline const boxtrees_node *boxtrees_next16_avx512(const boxtrees_node *nodes,
+                                                          const boxtrees_node *n,
+                                                          const boxtrees_extra *extras,
+                                                          const float *features,
+                                                          int64_t stride, const int64_t *types,
+                                                          int64_t base, __mmask16 live)
+{
+    if (n->extra >= 0) {
+        int32_t count = boxtrees_count_extra(n, extras, features, stride, types);
+        return nodes + (count < n->threshold ? n->left : n->right);
+    }
+    unsigned lo = (unsigned)(types[n->object_type] - base);
+    unsigned hi = (unsigned)(types[n->object_type + 1] - base);
+    __mmask16 of_type = (__mmask16)(((1u << hi) - 1u) & ~((1u << lo) - 1u));
+    __m512 xs = _mm512_maskz_loadu_ps(live, features + n->x_column * stride + base);
+    __m512 ys = _mm512_maskz_loadu_ps(live, features + n->y_column * stride + base);
+    __mmask16 in = of_type & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[0]), _CMP_GT_OQ)
+                   & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[1]), _CMP_LT_OQ)
+                   & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[2]), _CMP_GT_OQ)
+                   & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[3]), _CMP_LT_OQ);
+    int32_t count = __builtin_popcount((unsigned)in);
+    return nodes + (count < n->threshold ? n->left : n->right);
+}
+
+/* Walk `n_walks` (at most BOXTREES_WALKS) samples of at most 16 objects each, sample ids
+   `ids`, one step each in turn until all are at their leaves: the walks are independent, so
+   the CPU overlaps one's loads with another's tests, where a single walk waits for each node
+   before it can read the next. */
+__attribute__((target("avx512f")))
+static void boxtrees_walk16_avx512(const boxtrees_node *nodes, const boxtrees_extra *extras,
+                                   const float *features, int64_t stride, const int64_t *types,
+                                   int64_t types_stride, const int64_t *ids, int n_walks,
+                                   int64_t *out)
+{
+    const boxtrees_node *at[BOXTREES_WALKS];
+    const int64_t *ts[BOXTREES_WALKS];
+    int64_t base[BOXTREES_WALKS];
+    __mmask16 live[BOXTREES_WALKS];
+    for (int w = 0; w < n_walks; w++) {
+        at[w] = nodes;
+        ts[w] = types + ids[w] * types_stride;
+        base[w] = ts[w][0];
+        live[w] = (__mmask16)((1u << (ts[w][types_stride - 1] - base[w])) - 1u);
+    }
+    int walking;
+    do {
+        walking = 0;
+        for (int w = 0; w < n_walks; w++)
+            if (at[w]->left != -1) {
+                at[w] = boxtrees_next16_avx512(nodes, at[w], extras, features, stride, ts[w],
+                                               base[w], live[w]);
+                walking = 1;
+            }
+    } while (walking);
+    for (int w = 0; w < n_walks; w++)
+        out[ids[w]] = at[w] - nodes;
+}
+
+/* Samples of at most 16 objects are walked BOXTREES_WALKS at a time (boxtrees_walk16_avx512);
+   larger ones one at a time, 16 of their objects of a type per step. */
 __attribute__((target("avx512f")))
 static void boxtrees_find_leaves_avx512(const boxtrees_node *nodes,
                                         const boxtrees_extra *extras, const float *features,
                                         int64_t stride, const int64_t *types,
                                         int64_t types_stride, int64_t n_samples, int64_t *out)
 {
-    int64_t i = 0;
-    for (; i + BOXTREES_WALKS <= n_samples; i += BOXTREES_WALKS) {
-        const boxtrees_node *at[BOXTREES_WALKS];
-        for (int w = 0; w < BOXTREES_WALKS; w++)
-            at[w] = nodes;
-        int walking;
-        do {
-            walking = 0;
-            for (int w = 0; w < BOXTREES_WALKS; w++)
-                if (at[w]->left != -1) {
-                    at[w] = boxtrees_next_avx512(nodes, at[w], extras, features, stride,
-                                                 types + (i + w) * types_stride);
-                    walking = 1;
-                }
-        } while (walking);
-        for (int w = 0; w < BOXTREES_WALKS; w++)
-            out[i + w] = at[w] - nodes;
+    int64_t ids[BOXTREES_WALKS];
+    int n_waiting = 0;
+    for (int64_t i = 0; i < n_samples; i++) {
+        const int64_t *ts = types + i * types_stride;
+        if (ts[types_stride - 1] - ts[0] > 16) {
+            out[i] = boxtrees_find_leaf_avx512(nodes, extras, features, stride, ts);
+            continue;
+        }
+        ids[n_waiting++] = i;
+        if (n_waiting == BOXTREES_WALKS) {
+            boxtrees_walk16_avx512(nodes, extras, features, stride, types, types_stride, ids,
+                                   n_waiting, out);
+            n_waiting = 0;
+        }
     }
-    for (; i < n_samples; i++)
-        out[i] = boxtrees_find_leaf_avx512(nodes, extras, features, stride,
-                                           types + i * types_stride);
+    if (n_waiting)
+        boxtrees_walk16_avx512(nodes, extras, features, stride, types, types_stride, ids,
+                               n_waiting, out);
 }
 #endif
 

@@ -75,9 +75,11 @@ def test_predict_matches_numpy_reference_traversal(test_type, traversal_kernel):
         test_width=1.5, random_state=0,
     ).fit(X, y)
     trees = trees_of(forest)
-    # unseen type 9 at predict time must match no test; sets with more objects of a type than
-    # the SIMD kernel tests at once (16)
+    # unseen type 9 at predict time must match no test; sets of up to 16 objects and of more,
+    # which the AVX-512 kernel walks differently, side by side; sets with more objects of a
+    # type than it tests at once (16)
     X_new = (random_sets(rng, 300, n_types=10) + [np.empty((0, 3))]
+             + random_sets(rng, 100, max_objects=20)
              + random_sets(rng, 50, max_objects=80, n_types=2))
     leaves = np.array([[reference_leaf(t, s) for t in trees] for s in X_new])
     expected = np.mean(

@@ -143,7 +143,9 @@ def test_a_box_spans_at_most_eight_columns():
 @pytest.mark.parametrize("refine_tests", [False, True])
 def test_boxes_over_groups_of_more_columns_walk_as_in_numpy(groups, test_type, refine_tests):
     rng = np.random.default_rng(5)
-    X, X_test = object_sets(rng, 300, 5, max_objects=20), object_sets(rng, 80, 5)
+    # test sets of up to 16 objects and of more (walked differently with AVX-512)
+    X = object_sets(rng, 300, 5, max_objects=20)
+    X_test = object_sets(rng, 80, 5, max_objects=20)
     y = np.array([float(((s[:, :3] > 0).all(axis=1)).sum()) for s in X])
     forest = BoxExtraTreesRegressor(3, n_tests=30, min_samples_split=4, test_type=test_type,
                                     test_width=0.2, column_groups=groups, bootstrap=False,
