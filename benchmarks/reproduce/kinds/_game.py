@@ -108,7 +108,8 @@ def make_agent(settings, budget, seed, samples):
                keep_data=settings.keep_data,
                max_samples=max(settings.max_samples or samples, samples),
                exploration_initial_eps=THESIS_EPSILON, exploration_final_eps=THESIS_EPSILON,
-               tie_break="first", n_envs=min(400, samples), eval_seeds=reference_seeds(env, budget), seed=seed)
+               tie_break="first", n_envs=min(400, samples),
+               eval_seeds=reference_seeds(env, budget), seed=seed)
 
 
 def forest_cost(settings):
