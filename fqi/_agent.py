@@ -25,8 +25,8 @@ from ._envs import (_check_env, _close_built, _evaluation_vector, _make_vector, 
 from ._evaluate import _eval_seeds, evaluate
 from ._logger import CSVLogger, _KeyValueLogger
 from ._observations import _ObjectRows, _observation_format
-from ._q_function import (_check_leaf_means, _checked_prediction, _DoubleQFunction,
-                          _QFunction)
+from ._q_function import (_ActionInputQFunction, _check_leaf_means, _checked_prediction,
+                          _DoubleQFunction, _QFunction, _with_actions)
 from ._saving import _read_save, _write_save
 from ._typing import Callback, Dataset, EnvLike, Logger, Observation, Regressor
 
@@ -50,9 +50,9 @@ class FQI:
     transitions, several fitted-Q backups per collection round, and the data regimes of the
     thesis (section 3.2.2).
 
-    The Q-function is one regressor per action, each a fresh `sklearn.base.clone` of
-    `regressor` fitted at every iteration; the agent only calls ``fit(X, y)`` and
-    ``predict(X)``. ``X`` follows the env's observation space: for a ``Box``, a 2D float
+    The Q-function is one regressor per action (or one over observations and actions:
+    `action_input`), each a fresh `sklearn.base.clone` of `regressor` fitted at every
+    iteration; the agent only calls ``fit(X, y)`` and ``predict(X)``. ``X`` follows the env's observation space: for a ``Box``, a 2D float
     matrix with one flattened observation per row, so any scikit-learn regressor plugs in;
     for ``Sequence(Box(shape=(d + 1,)))`` (sets of ``[f_1, ..., f_d, type]`` objects), one
     `boxtrees.ObjectSets` (``data`` + ``offsets``) per batch, which
@@ -160,6 +160,14 @@ class FQI:
         removes the upward bias of ``max_a Q(s', a)`` over fitting errors. Actions follow
         the mean of the two. With `leaf_backups` each half's leaves hold the means of its
         own half's targets.
+    action_input : bool, default=False
+        Fit one regressor on every transition, its input the observation followed by the
+        action's one-hot columns (``X`` has ``n_features + n_actions`` columns), instead of
+        one regressor per action on that action's transitions (as MushroomRL's FQI with a
+        state-action regressor). The actions then share the regressor's splits on the
+        observation, so their Q-values err together, and the differences between them,
+        which choose the action, come out finer where they are small (Acrobot-v1:
+        ``docs/fqi.md``). Feature-vector (``Box``) observations only; not with `double`.
     n_envs : int, default=None
         Envs played side by side while collecting; None: the vector env's own number, or
         16 for any other env form.
@@ -248,7 +256,8 @@ class FQI:
                  exploration_fraction: float = 0.1, exploration_initial_eps: float = 1.0,
                  exploration_final_eps: float = 0.05,
                  exploration_zeta: float | None = None, tie_break: str = "random",
-                 leaf_backups: int = 0, double: bool = False, n_envs: int | None = None,
+                 leaf_backups: int = 0, double: bool = False, action_input: bool = False,
+                 n_envs: int | None = None,
                  eval_episodes: int | None = None, eval_seeds: Sequence[int] | None = None,
                  eval_env: EnvLike | None = None, n_jobs: int = 1,
                  log_path: str | os.PathLike[str] | None = None, seed: int | None = None,
@@ -261,7 +270,9 @@ class FQI:
         # None until set_env (below) sets them: afterwards always the env's spaces
         self.observation_space = self.action_space = None  # type: ignore[assignment]
         self.exploration_rate = self.exploration_initial_eps
-        self._q = None  # the last iteration's _QFunction (_DoubleQFunction if double)
+        # the last iteration's _QFunction (_DoubleQFunction if double, _ActionInputQFunction
+        # if action_input)
+        self._q = None
         self.history = []
         self.num_timesteps = 0
         self.iteration = 0
@@ -306,6 +317,10 @@ class FQI:
                             f"each sample in each tree, as scikit-learn's forests have); "
                             f"{type(regressor).__name__} has none")
         self.double = _check_bool("double", params["double"])
+        self.action_input = _check_bool("action_input", params["action_input"])
+        if self.double and self.action_input:
+            raise ValueError("double and action_input cannot be combined: Double FQI fits "
+                             "a regressor per action on each half of the data")
         self.samples_per_iteration = _check_int("samples_per_iteration",
                                                 params["samples_per_iteration"], 1)
         resample_every = params["resample_every"]
@@ -359,6 +374,10 @@ class FQI:
             action_space = vector.single_action_space
             n_actions = _n_actions(action_space)
             observations = _observation_format(observation_space)
+            if self.action_input and isinstance(observations, _ObjectRows):
+                raise ValueError(f"action_input needs feature-vector (Box) observations, not "
+                                 f"{observation_space}: the action is appended to each "
+                                 f"observation's features")
             if self.observation_space is not None and (observation_space, action_space) != (
                     self.observation_space, self.action_space):
                 raise ValueError(f"env has the spaces {observation_space} and {action_space}; "
@@ -368,7 +387,7 @@ class FQI:
                                              (observation_space, action_space),
                                              len(self._eval_seeds))
             first = _tried(vector, observations)
-            self._check_regressor(observations, first)
+            self._check_regressor(observations, first, n_actions)
         except BaseException:
             _close_built(vector, env)
             _close_built(eval_vector, eval_env)
@@ -380,10 +399,13 @@ class FQI:
         self._collector = self._held = None
         self._data = None
 
-    def _check_regressor(self, observations, batch):
+    def _check_regressor(self, observations, batch, n_actions):
         """Fit a clone of the regressor on `batch` (zero targets; distinct ones with
-        `leaf_backups`, whose leaf means are checked too) and check its predictions, so that
-        a regressor that cannot take these observations fails now."""
+        `leaf_backups`, whose leaf means are checked too; with `action_input`, each
+        observation with an action of the `n_actions` appended) and check its predictions,
+        so that a regressor that cannot take these observations fails now."""
+        if self.action_input:
+            batch = _with_actions(batch, np.arange(len(batch)) % n_actions, n_actions)
         model = clone(self.regressor)
         # distinct targets when the leaves' means are checked (leaf_backups), else zeros
         y = np.arange(len(batch), dtype=float) * self.leaf_backups
@@ -604,6 +626,7 @@ class FQI:
             args = (self.regressor, self._data, targets, self.n_actions, self._fit_rng,
                     self._q, self.iteration)
             self._q = (_DoubleQFunction.fit(*args, split) if self.double
+                       else _ActionInputQFunction.fit(*args) if self.action_input
                        else _QFunction.fit(*args))
         with _timed(times, "t_evaluate"):
             result = (evaluate(self, self._eval_env, seeds=self._eval_seeds)
@@ -740,7 +763,8 @@ class FQI:
     @property
     def q_functions_(self) -> list[Regressor] | None:
         """The fitted ``Q_n``, one regressor per action (None before the first iteration);
-        with `double`, the first half's then the second half's: ``2 * n_actions``."""
+        with `double`, the first half's then the second half's: ``2 * n_actions``; with
+        `action_input`, the one regressor."""
         return None if self._q is None else self._q.models
 
     def predict(self, observation: Observation, state: object = None,
@@ -811,8 +835,8 @@ class FQI:
             Constructor parameters to change (``log_path``, ``n_jobs``, ``eval_seeds``...),
             checked as by the constructor; the others keep their saved values (a saved
             ``log_path`` too: further iterations append to that CSV; pass
-            ``log_path=None`` to log nowhere). ``double`` changes only on an agent that
-            has no Q-function yet (ValueError otherwise).
+            ``log_path=None`` to log nowhere). ``double`` and ``action_input`` change
+            only on an agent that has no Q-function yet (ValueError otherwise).
 
         Returns
         -------
@@ -828,9 +852,10 @@ class FQI:
         agent = cls.__new__(cls)
         agent.__dict__.update({k: v for k, v in state.items() if k not in names})
         agent._set_params({**{name: state[name] for name in names}, **params})
-        if agent._q is not None and agent.double != state["double"]:
-            raise ValueError(f"double cannot change once the agent has a Q-function: {path} "
-                             f"holds a {'Double ' if state['double'] else ''}FQI agent's")
+        for name in ("double", "action_input"):
+            if agent._q is not None and getattr(agent, name) != state[name]:
+                raise ValueError(f"{name} cannot change once the agent has a Q-function: "
+                                 f"{path} holds one made with {name}={state[name]}")
         agent._env = agent._eval_env = agent._collector = agent._held = None
         agent._data = agent._logger = None
         env = agent.env if env is None else env

@@ -41,11 +41,7 @@ class _QFunction:
                               f"previous Q-function", RuntimeWarning, stacklevel=4)
                 models.append(previous.models[action])
                 continue
-            model = clone(regressor)
-            seed = int(rng.integers(2**31 - 1))
-            model.set_params(**{key: seed for key in model.get_params()
-                                if key == "random_state" or key.endswith("__random_state")})
-            models.append(model.fit(data.states[mask], targets[mask]))
+            models.append(_seeded_clone(regressor, rng).fit(data.states[mask], targets[mask]))
         return cls(models, iteration)
 
     def future(self, data, n_jobs=1, split=None):
@@ -109,6 +105,86 @@ class _QFunction:
                 prediction, len(batch), lambda: f"iteration {self.iteration}'s Q-function of "
                 f"action {action} ({self.models[action]!r})")
         return q
+
+
+class _ActionInputQFunction:
+    """``Q_n`` as one regressor over each observation followed by its action's one-hot
+    columns (FQI's ``action_input``): the actions share its splits on the observation, so
+    their Q-values err together and their differences, which choose the action, are
+    estimated more finely than by one regressor per action. Feature-vector observations.
+
+    Parameters
+    ----------
+    model : regressor
+        Fitted on ``_with_actions(states, actions, n_actions)``.
+    n_actions : int
+    iteration : int
+        The iteration that fitted it (named in errors).
+    """
+
+    def __init__(self, model, n_actions, iteration):
+        self.model, self.n_actions, self.iteration = model, n_actions, iteration
+
+    @property
+    def models(self):
+        """The one regressor, in a list (as `_QFunction.models`)."""
+        return [self.model]
+
+    @classmethod
+    def fit(cls, regressor, data, targets, n_actions, rng, previous, iteration):
+        """A clone of `regressor` (its ``random_state`` parameters drawn from `rng`) fitted
+        on every transition; `previous` is unused (every action is in the input)."""
+        model = _seeded_clone(regressor, rng)
+        return cls(model.fit(_with_actions(data.states, data.actions, n_actions), targets),
+                   n_actions, iteration)
+
+    def _every_action(self, batch):
+        """Each observation of `batch` with each action in turn: ``n_actions`` rows per
+        observation, observation by observation."""
+        return _with_actions(np.repeat(batch, self.n_actions, axis=0),
+                             np.tile(np.arange(self.n_actions), len(batch)), self.n_actions)
+
+    def values(self, batch, n_jobs=1):
+        """``Q(s, a)`` of every action for the observations of `batch`, shape ``(n,
+        n_actions)``, in one call of the regressor's ``predict`` (its own threads: `n_jobs`
+        is unused here), checked as in `_QFunction.values`."""
+        n = len(batch) * self.n_actions
+        q = _checked_prediction(self.model.predict(self._every_action(batch)), n,
+                                lambda: f"iteration {self.iteration}'s Q-function "
+                                        f"({self.model!r})")
+        return q.reshape(len(batch), self.n_actions)
+
+    def future(self, data, n_jobs=1, split=None):
+        """``max_a Q(s', a)`` for the next state of every transition of `data`."""
+        return self.values(data.next_states, n_jobs).max(axis=1)
+
+    def backups(self, data, targets, discounts, n_backups, split=None):
+        """`_QFunction.backups` on the one regressor: its leaves hold the mean targets of
+        every transition that reaches them, whatever its action."""
+        table = _LeafTable(self.model, _with_actions(data.states, data.actions, self.n_actions),
+                           self._every_action(data.next_states))
+        for _ in range(n_backups):
+            q = table.next_values(targets).reshape(len(data), self.n_actions)
+            targets = data.rewards + discounts * q.max(axis=1)
+        return targets
+
+
+def _with_actions(states, actions, n_actions):
+    """The rows of the observation matrix `states` followed by the one-hot columns of
+    `actions` (``n_actions`` columns, in the matrix's dtype)."""
+    onehot = np.zeros((len(states), n_actions), dtype=states.dtype)
+    onehot[np.arange(len(states)), actions] = 1
+    return np.hstack([states, onehot])
+
+
+def _seeded_clone(regressor, rng):
+    """A clone of `regressor` whose ``random_state`` parameters (nested ones too) are one
+    seed drawn from `rng`."""
+    model = clone(regressor)
+    seed = int(rng.integers(2**31 - 1))
+    model.set_params(**{key: seed for key in model.get_params()
+                        if key == "random_state" or key.endswith("__random_state")})
+    return model
 
 
 class _DoubleQFunction:

@@ -363,6 +363,7 @@ def test_thesis_run_is_unchanged():
     ({"exploration_zeta": 0.5}, ValueError, r"exploration_zeta must lie in \[1.0, inf\]"),
     ({"exploration_zeta": "2"}, TypeError, "exploration_zeta must be a number"),
     ({"double": 1}, TypeError, "double must be a bool"),
+    ({"action_input": "yes"}, TypeError, "action_input must be a bool"),
 ])
 def test_bad_parameters(params, error, match):
     with pytest.raises(error, match=match):
@@ -424,7 +425,7 @@ def _truncated_save(agent, path):
     (lambda agent, path: joblib.dump({"format": 1}, path),
      f"FQI save of format version 1; this version of fqi reads version {_SAVE_FORMAT}"),
     (lambda agent, path: joblib.dump({"format": _SAVE_FORMAT, "state": {}}, path),
-     "not an agent saved by FQI.save: it lacks _q, action_space, double, env"),
+     "not an agent saved by FQI.save: it lacks _q, action_input, action_space, double, env"),
     (lambda agent, path: joblib.dump({"format": _SAVE_FORMAT, "state": [1]}, path),
      "not an agent saved by FQI.save: it lacks state"),
 ])

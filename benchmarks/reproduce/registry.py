@@ -648,7 +648,8 @@ def _control(env_id):
 FQI_DEFAULTS_MEASURED = {
     "gamma": 0.99, "samples_per_iteration": 2_500, "resample_every": 5, "keep_data": True,
     "max_samples": 100_000, "exploration_fraction": 0.1, "exploration_initial_eps": 1.0,
-    "exploration_final_eps": 0.05, "tie_break": "random", "leaf_backups": 0}
+    "exploration_final_eps": 0.05, "tie_break": "random", "leaf_backups": 0, "double": False,
+    "action_input": False}
 # The defaults of FQI, measured: variations of one setting at a time on CartPole-v1, made
 # before `tie_break` existed (so with ties to the first action); then the defaults with ties
 # broken at random.

@@ -1,0 +1,115 @@
+"""FQI with one regressor over observations and actions (``FQI(action_input=True)``): the
+observation followed by the action's one-hot columns is the regressor's input."""
+import gymnasium as gym
+import numpy as np
+import pytest
+from sklearn.ensemble import ExtraTreesRegressor
+from sklearn.linear_model import LinearRegression
+
+from fqi import FQI, RandomPolicy, evaluate
+from fqi._collect import _Transitions
+from fqi._q_function import _ActionInputQFunction, _with_actions
+
+
+def _transitions(n, n_actions=3, seed=0):
+    rng = np.random.default_rng(seed)
+    return _Transitions(rng.normal(size=(n, 2)), rng.integers(n_actions, size=n),
+                        rng.normal(size=n), rng.normal(size=(n, 2)), rng.random(n) < 0.2)
+
+
+def test_the_input_is_the_observation_then_the_actions_one_hot_columns():
+    states = np.array([[0.5, -1.0], [2.0, 3.0]], dtype=np.float32)
+    joint = _with_actions(states, np.array([2, 0]), 3)
+    np.testing.assert_array_equal(joint, [[0.5, -1.0, 0, 0, 1], [2.0, 3.0, 1, 0, 0]])
+    assert joint.dtype == np.float32
+
+
+def test_one_regressor_fitted_on_every_transition_values_every_action():
+    data = _transitions(300)
+    targets = 2 * data.states[:, 0] - data.states[:, 1] + np.array([0.0, 1.5, -4.0])[
+        data.actions]
+    q = _ActionInputQFunction.fit(LinearRegression(), data, targets, 3,
+                                  np.random.default_rng(0), None, 7)
+    assert len(q.models) == 1 and q.iteration == 7
+    assert q.models[0].n_features_in_ == 2 + 3
+    probe = np.random.default_rng(1).normal(size=(20, 2))
+    expected = (2 * probe[:, :1] - probe[:, 1:]) + np.array([0.0, 1.5, -4.0])
+    np.testing.assert_allclose(q.values(probe), expected, atol=1e-9)
+    np.testing.assert_allclose(q.future(data), q.values(data.next_states).max(axis=1))
+
+
+def test_leaf_backups_average_every_transitions_targets_in_the_one_forest():
+    data = _transitions(150)
+    rng = np.random.default_rng(1)
+    fitted_on = rng.normal(size=150)
+    forest = ExtraTreesRegressor(n_estimators=3, min_samples_split=10, random_state=0)
+    q = _ActionInputQFunction.fit(forest, data, fitted_on, 3, rng, None, 0)
+    discounts = np.where(data.terminated, 0.0, 0.9)
+    # on the targets it was fitted on, a backup is the fitted values' bootstrap
+    np.testing.assert_allclose(q.backups(data, fitted_on, discounts, 1),
+                               data.rewards + discounts * q.future(data))
+    # on others, the leaves' means of the targets of every transition, whatever its action
+    targets = rng.normal(size=150)
+    model = q.models[0]
+    leaves = model.apply(_with_actions(data.states, data.actions, 3))
+    future = np.empty((150, 3))
+    for action in range(3):
+        next_leaves = model.apply(_with_actions(data.next_states, np.full(150, action), 3))
+        for i in range(150):
+            future[i, action] = np.mean([targets[leaves[:, t] == next_leaves[i, t]].mean()
+                                         for t in range(3)])
+    np.testing.assert_allclose(q.backups(data, targets, discounts, 1),
+                               data.rewards + discounts * future.max(axis=1))
+
+
+def _agent(**params):
+    settings = dict(samples_per_iteration=500, resample_every=5, leaf_backups=3, n_envs=4,
+                    eval_episodes=0, action_input=True, seed=0)
+    return FQI(ExtraTreesRegressor(n_estimators=5, min_samples_leaf=2), "CartPole-v1",
+               **{**settings, **params})
+
+
+def test_action_input_fqi_learns_cartpole_and_saves(tmp_path):
+    """2,000 env steps: the greedy policy balances far longer than random play."""
+    agent = _agent().learn(total_timesteps=2000)
+    assert len(agent.q_functions_) == 1 and agent.q_functions_[0].n_features_in_ == 4 + 2
+    score = evaluate(agent, "CartPole-v1", seeds=range(10)).mean
+    random_mean = evaluate(RandomPolicy("CartPole-v1", seed=0), "CartPole-v1",
+                           seeds=range(10)).mean
+    assert random_mean < 30 and score > 100, (random_mean, score)
+    agent.save(tmp_path / "agent.joblib")
+    loaded = FQI.load(tmp_path / "agent.joblib")
+    assert loaded.action_input is True
+    obs = np.random.default_rng(0).normal(size=(50, 4))
+    assert agent.q_values(obs).shape == (50, 2)
+    np.testing.assert_array_equal(loaded.q_values(obs), agent.q_values(obs))
+    with pytest.raises(ValueError, match="action_input cannot change once the agent has a"):
+        FQI.load(tmp_path / "agent.joblib", action_input=False)
+
+
+def test_action_input_repeats_with_its_seed_and_differs_from_a_regressor_per_action():
+    obs = np.random.default_rng(0).normal(size=(50, 4))
+    first, again, per_action = (_agent(action_input=joint).learn(total_timesteps=1000)
+                                .q_values(obs) for joint in (True, True, False))
+    np.testing.assert_array_equal(again, first)
+    assert not np.allclose(per_action, first)
+
+
+def test_action_input_needs_feature_vectors_and_no_double():
+    with pytest.raises(ValueError, match="double and action_input cannot be combined"):
+        _agent(double=True)
+    objects = gym.spaces.Sequence(gym.spaces.Box(-5.0, 5.0, shape=(3,)))
+
+    class ObjectEnv(gym.Env):
+        observation_space, action_space = objects, gym.spaces.Discrete(2)
+
+        def reset(self, *, seed=None, options=None):
+            super().reset(seed=seed)
+            return (np.zeros((1, 3), dtype=np.float32),), {}
+
+        def step(self, action):
+            return (np.zeros((1, 3), dtype=np.float32),), 0.0, False, False, {}
+
+    with pytest.raises(ValueError, match="action_input needs feature-vector"):
+        FQI(ExtraTreesRegressor(n_estimators=2), ObjectEnv(), action_input=True,
+            eval_episodes=0, n_envs=1)
