@@ -43,6 +43,24 @@ THESIS_TREE = dict(test_type="fixed", test_width=1.0, relative_width=False, refi
 THESIS_FOREST = dict(THESIS_TREE, bootstrap=False)
 
 
+@pytest.fixture
+def cartpole_fqi():
+    """A factory of small FQI agents on CartPole-v1 (rounds of 500 steps from 4 envs, 5
+    backups a round, 3 leaf backups, 5 Extra-Trees, no evaluation, seed 0); its keyword
+    arguments are more FQI parameters."""
+    from sklearn.ensemble import ExtraTreesRegressor
+
+    from fqi import FQI
+
+    def make(**params):
+        settings = dict(samples_per_iteration=500, resample_every=5, leaf_backups=3,
+                        n_envs=4, eval_episodes=0, seed=0)
+        return FQI(ExtraTreesRegressor(n_estimators=5, min_samples_leaf=2), "CartPole-v1",
+                   **{**settings, **params})
+
+    return make
+
+
 @pytest.fixture(scope="session")
 def tiny_run(tmp_path_factory):
     """Every default experiment of the reproduction run at the tiny budget, once for all the

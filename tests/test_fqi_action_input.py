@@ -6,7 +6,7 @@ import pytest
 from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.linear_model import LinearRegression
 
-from fqi import FQI, RandomPolicy, evaluate
+from fqi import FQI
 from fqi._collect import _Transitions
 from fqi._q_function import _ActionInputQFunction, _with_actions
 
@@ -62,42 +62,21 @@ def test_leaf_backups_average_every_transitions_targets_in_the_one_forest():
                                data.rewards + discounts * future.max(axis=1))
 
 
-def _agent(**params):
-    settings = dict(samples_per_iteration=500, resample_every=5, leaf_backups=3, n_envs=4,
-                    eval_episodes=0, action_input=True, seed=0)
-    return FQI(ExtraTreesRegressor(n_estimators=5, min_samples_leaf=2), "CartPole-v1",
-               **{**settings, **params})
-
-
-def test_action_input_fqi_learns_cartpole_and_saves(tmp_path):
-    """2,000 env steps: the greedy policy balances far longer than random play."""
-    agent = _agent().learn(total_timesteps=2000)
-    assert len(agent.q_functions_) == 1 and agent.q_functions_[0].n_features_in_ == 4 + 2
-    score = evaluate(agent, "CartPole-v1", seeds=range(10)).mean
-    random_mean = evaluate(RandomPolicy("CartPole-v1", seed=0), "CartPole-v1",
-                           seeds=range(10)).mean
-    assert random_mean < 30 and score > 100, (random_mean, score)
-    agent.save(tmp_path / "agent.joblib")
-    loaded = FQI.load(tmp_path / "agent.joblib")
-    assert loaded.action_input is True
+def test_action_input_repeats_with_its_seed_and_differs_from_a_regressor_per_action(
+        cartpole_fqi):
     obs = np.random.default_rng(0).normal(size=(50, 4))
-    assert agent.q_values(obs).shape == (50, 2)
-    np.testing.assert_array_equal(loaded.q_values(obs), agent.q_values(obs))
-    with pytest.raises(ValueError, match="action_input cannot change once the agent has a"):
-        FQI.load(tmp_path / "agent.joblib", action_input=False)
-
-
-def test_action_input_repeats_with_its_seed_and_differs_from_a_regressor_per_action():
-    obs = np.random.default_rng(0).normal(size=(50, 4))
-    first, again, per_action = (_agent(action_input=joint).learn(total_timesteps=1000)
-                                .q_values(obs) for joint in (True, True, False))
+    agents = [cartpole_fqi(action_input=joint).learn(total_timesteps=1000)
+              for joint in (True, True, False)]
+    assert [agent.q_functions_[0].n_features_in_ for agent in agents] == [4 + 2, 4 + 2, 4]
+    first, again, per_action = (agent.q_values(obs) for agent in agents)
+    assert first.shape == (50, 2)
     np.testing.assert_array_equal(again, first)
     assert not np.allclose(per_action, first)
 
 
-def test_action_input_needs_feature_vectors_and_no_double():
+def test_action_input_needs_feature_vectors_and_no_double(cartpole_fqi):
     with pytest.raises(ValueError, match="double and action_input cannot be combined"):
-        _agent(double=True)
+        cartpole_fqi(action_input=True, double=True)
     objects = gym.spaces.Sequence(gym.spaces.Box(-5.0, 5.0, shape=(3,)))
 
     class ObjectEnv(gym.Env):

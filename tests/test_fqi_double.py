@@ -6,7 +6,6 @@ import pytest
 from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.linear_model import Ridge
 
-from fqi import FQI, RandomPolicy, evaluate
 from fqi._collect import _Transitions
 from fqi._q_function import _crossed, _DoubleQFunction, _QFunction
 
@@ -75,37 +74,10 @@ def test_double_leaf_backups_hold_each_halfs_own_targets():
                                data.rewards + discounts * _crossed(*halves, split))
 
 
-def _agent(**params):
-    settings = dict(samples_per_iteration=500, resample_every=5, leaf_backups=3, n_envs=4,
-                    eval_episodes=0, double=True, seed=0)
-    return FQI(ExtraTreesRegressor(n_estimators=5, min_samples_leaf=2), "CartPole-v1",
-               **{**settings, **params})
-
-
-def test_double_fqi_learns_cartpole(tmp_path):
-    """2,000 env steps: the greedy policy balances far longer than random play."""
-    agent = _agent().learn(total_timesteps=2000)
-    assert len(agent.q_functions_) == 4 and agent.iteration == 20
-    score = evaluate(agent, "CartPole-v1", seeds=range(10)).mean
-    random_mean = evaluate(RandomPolicy("CartPole-v1", seed=0), "CartPole-v1",
-                           seeds=range(10)).mean
-    assert random_mean < 30 and score > 100, (random_mean, score)  # measured: 21.3, 475
-    agent.save(tmp_path / "agent.joblib")
-    loaded = FQI.load(tmp_path / "agent.joblib")
-    assert loaded.double is True
-    obs = np.random.default_rng(0).normal(size=(50, 4))
-    np.testing.assert_array_equal(loaded.q_values(obs), agent.q_values(obs))
-    with pytest.raises(ValueError, match="double cannot change once the agent has a Q-f"):
-        FQI.load(tmp_path / "agent.joblib", double=False)
-    unfitted = _agent(double=False)
-    unfitted.save(tmp_path / "unfitted.joblib")
-    assert FQI.load(tmp_path / "unfitted.joblib", double=True).double is True
-
-
 @pytest.mark.parametrize("leaf_backups", [0, 3])
-def test_double_fqi_repeats_with_its_seed_and_differs_from_fqi(leaf_backups):
+def test_double_fqi_repeats_with_its_seed_and_differs_from_fqi(cartpole_fqi, leaf_backups):
     obs = np.random.default_rng(0).normal(size=(50, 4))
-    first, again, single = (_agent(leaf_backups=leaf_backups, double=double)
+    first, again, single = (cartpole_fqi(leaf_backups=leaf_backups, double=double)
                             .learn(total_timesteps=1000).q_values(obs)
                             for double in (True, True, False))
     np.testing.assert_array_equal(again, first)
