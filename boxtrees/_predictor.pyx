@@ -12,8 +12,8 @@ only the sample's objects of the tested type, attribute by attribute; they re-va
 of use, the rows and offsets they read (a batch may have changed since it was checked), and
 report the first bad row instead of reading past an array. Samples are processed in blocks,
 tree by tree, so that a tree's nodes stay in cache across a block. The walk itself is a kernel
-of ``_simd.h``: with AVX-512 it tests up to 16 of a sample's objects at once, and walks
-two samples side by side.
+of ``_simd.h``: with AVX-512 it walks two samples side by side, and tests up to 16 of a
+sample's objects at once.
 """
 import numpy as np
 

@@ -8,9 +8,9 @@
  * - partition: renumber a run's sample ids and move, stably, the objects of the left child's
  *   samples (new id < mid) before those of the right child's;
  * - find_leaves: walk samples down one tree (the AVX-512 version walks BOXTREES_WALKS samples
- *   of at most sixteen objects side by side, each node testing all of a sample's objects in
- *   one load and keeping the lanes of the node's type; a larger sample is walked alone, up
- *   to sixteen of its objects of a type at once).
+ *   side by side: for a sample of at most sixteen objects a node tests all of them in one
+ *   load and keeps the lanes of its type; for a larger one, up to sixteen of its objects of
+ *   the node's type at once).
  *
  * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
  * run time, so the default build stays portable) sixteen objects are handled per step; with
@@ -482,17 +482,6 @@ static inline const boxtrees_node *boxtrees_next_avx512(const boxtrees_node *nod
     return nodes + (count < n->threshold ? n->left : n->right);
 }
 
-__attribute__((target("avx512f")))
-static int64_t boxtrees_find_leaf_avx512(const boxtrees_node *nodes,
-                                         const boxtrees_extra *extras, const float *features,
-                                         int64_t stride, const int64_t *types)
-{
-    const boxtrees_node *n = nodes;
-    while (n->left != -1)
-        n = boxtrees_next_avx512(nodes, n, extras, features, stride, types);
-    return n - nodes;
-}
-
 /* The child of inner node `n` for a sample of at most 16 objects (of the forest's types):
    its objects of every type are lanes 0 to popcount(live) - 1 of one load at features + c *
    stride + base, those of type position t lanes types[t] - base to types[t + 1] - base. The
@@ -522,15 +511,16 @@ static inline const boxtrees_node *boxtrees_next16_avx512(const boxtrees_node *n
     return nodes + (count < n->threshold ? n->left : n->right);
 }
 
-/* Walk `n_walks` (at most BOXTREES_WALKS) samples of at most 16 objects each, sample ids
-   `ids`, one step each in turn until all are at their leaves: the walks are independent, so
-   the CPU overlaps one's loads with another's tests, where a single walk waits for each node
-   before it can read the next. */
-__attribute__((target("avx512f")))
-static void boxtrees_walk16_avx512(const boxtrees_node *nodes, const boxtrees_extra *extras,
-                                   const float *features, int64_t stride, const int64_t *types,
-                                   int64_t types_stride, const int64_t *ids, int n_walks,
-                                   int64_t *out)
+/* Walk `n_walks` (at most BOXTREES_WALKS) samples, sample ids `ids`, one step each in turn
+   until all are at their leaves: the walks are independent, so the CPU overlaps one's loads
+   with another's tests, where a single walk waits for each node before it can read the
+   next. With `short_sets` every sample has at most 16 objects (boxtrees_next16_avx512). */
+__attribute__((target("avx512f"), always_inline))
+static inline void boxtrees_walk_avx512(const boxtrees_node *nodes,
+                                        const boxtrees_extra *extras, const float *features,
+                                        int64_t stride, const int64_t *types,
+                                        int64_t types_stride, const int64_t *ids, int n_walks,
+                                        int64_t *out, int short_sets)
 {
     const boxtrees_node *at[BOXTREES_WALKS];
     const int64_t *ts[BOXTREES_WALKS];
@@ -540,15 +530,18 @@ static void boxtrees_walk16_avx512(const boxtrees_node *nodes, const boxtrees_ex
         at[w] = nodes;
         ts[w] = types + ids[w] * types_stride;
         base[w] = ts[w][0];
-        live[w] = (__mmask16)((1u << (ts[w][types_stride - 1] - base[w])) - 1u);
+        live[w] = short_sets ? (__mmask16)((1u << (ts[w][types_stride - 1] - base[w])) - 1u)
+                             : 0;
     }
     int walking;
     do {
         walking = 0;
         for (int w = 0; w < n_walks; w++)
             if (at[w]->left != -1) {
-                at[w] = boxtrees_next16_avx512(nodes, at[w], extras, features, stride, ts[w],
-                                               base[w], live[w]);
+                at[w] = short_sets ? boxtrees_next16_avx512(nodes, at[w], extras, features,
+                                                            stride, ts[w], base[w], live[w])
+                                   : boxtrees_next_avx512(nodes, at[w], extras, features,
+                                                          stride, ts[w]);
                 walking = 1;
             }
     } while (walking);
@@ -556,32 +549,34 @@ static void boxtrees_walk16_avx512(const boxtrees_node *nodes, const boxtrees_ex
         out[ids[w]] = at[w] - nodes;
 }
 
-/* Samples of at most 16 objects are walked BOXTREES_WALKS at a time (boxtrees_walk16_avx512);
-   larger ones one at a time, 16 of their objects of a type per step. */
+/* Samples queued by size, of at most 16 objects (queue 1) or more (queue 0), and walked
+   BOXTREES_WALKS of a queue at a time (boxtrees_walk_avx512). */
 __attribute__((target("avx512f")))
 static void boxtrees_find_leaves_avx512(const boxtrees_node *nodes,
                                         const boxtrees_extra *extras, const float *features,
                                         int64_t stride, const int64_t *types,
                                         int64_t types_stride, int64_t n_samples, int64_t *out)
 {
-    int64_t ids[BOXTREES_WALKS];
-    int n_waiting = 0;
+    int64_t ids[2][BOXTREES_WALKS];
+    int n_queued[2] = {0, 0};
     for (int64_t i = 0; i < n_samples; i++) {
         const int64_t *ts = types + i * types_stride;
-        if (ts[types_stride - 1] - ts[0] > 16) {
-            out[i] = boxtrees_find_leaf_avx512(nodes, extras, features, stride, ts);
+        int short_set = ts[types_stride - 1] - ts[0] <= 16;
+        ids[short_set][n_queued[short_set]++] = i;
+        if (n_queued[short_set] < BOXTREES_WALKS)
             continue;
-        }
-        ids[n_waiting++] = i;
-        if (n_waiting == BOXTREES_WALKS) {
-            boxtrees_walk16_avx512(nodes, extras, features, stride, types, types_stride, ids,
-                                   n_waiting, out);
-            n_waiting = 0;
-        }
+        if (short_set)
+            boxtrees_walk_avx512(nodes, extras, features, stride, types, types_stride, ids[1],
+                                 BOXTREES_WALKS, out, 1);
+        else
+            boxtrees_walk_avx512(nodes, extras, features, stride, types, types_stride, ids[0],
+                                 BOXTREES_WALKS, out, 0);
+        n_queued[short_set] = 0;
     }
-    if (n_waiting)
-        boxtrees_walk16_avx512(nodes, extras, features, stride, types, types_stride, ids,
-                               n_waiting, out);
+    boxtrees_walk_avx512(nodes, extras, features, stride, types, types_stride, ids[0],
+                         n_queued[0], out, 0);
+    boxtrees_walk_avx512(nodes, extras, features, stride, types, types_stride, ids[1],
+                         n_queued[1], out, 1);
 }
 #endif
 

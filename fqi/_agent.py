@@ -52,8 +52,9 @@ class FQI:
 
     The Q-function is one regressor per action (or one over observations and actions:
     `action_input`), each a fresh `sklearn.base.clone` of `regressor` fitted at every
-    iteration; the agent only calls ``fit(X, y)`` and ``predict(X)``. ``X`` follows the env's observation space: for a ``Box``, a 2D float
-    matrix with one flattened observation per row, so any scikit-learn regressor plugs in;
+    iteration; the agent only calls ``fit(X, y)`` and ``predict(X)``. ``X`` follows the
+    env's observation space: for a ``Box``, a 2D float matrix with one flattened
+    observation per row, so any scikit-learn regressor plugs in;
     for ``Sequence(Box(shape=(d + 1,)))`` (sets of ``[f_1, ..., f_d, type]`` objects), one
     `boxtrees.ObjectSets` (``data`` + ``offsets``) per batch, which
     `boxtrees.BoxExtraTreesRegressor` or a pipeline starting with `boxtrees.GridCounts` take.
@@ -165,8 +166,8 @@ class FQI:
         action's one-hot columns (``X`` has ``n_features + n_actions`` columns), instead of
         one regressor per action on that action's transitions (as MushroomRL's FQI with a
         state-action regressor). The actions then share the regressor's splits on the
-        observation, so their Q-values err together, and the differences between them,
-        which choose the action, come out finer where they are small (Acrobot-v1:
+        observation, so their Q-values err together where separate regressors err apart
+        (the likely reason it plays better on Acrobot-v1, not measured apart:
         ``docs/fqi.md``). Feature-vector (``Box``) observations only; not with `double`.
     n_envs : int, default=None
         Envs played side by side while collecting; None: the vector env's own number, or
@@ -204,7 +205,8 @@ class FQI:
     exploration_rate : float
         The current probability of a random action (of the next collection).
     q_functions_ : list of regressors
-        The fitted ``Q_n``, one per action.
+        The fitted ``Q_n``: one per action (two per action with `double`, one in all with
+        `action_input`).
     history : list of dict
         One record per iteration: ``iteration``, ``reward`` (total return of the evaluation
         episodes), ``mean_return`` (per episode), ``n_samples`` (data set size),
@@ -374,10 +376,7 @@ class FQI:
             action_space = vector.single_action_space
             n_actions = _n_actions(action_space)
             observations = _observation_format(observation_space)
-            if self.action_input and isinstance(observations, _ObjectRows):
-                raise ValueError(f"action_input needs feature-vector (Box) observations, not "
-                                 f"{observation_space}: the action is appended to each "
-                                 f"observation's features")
+            self._check_action_input(observations, observation_space)
             if self.observation_space is not None and (observation_space, action_space) != (
                     self.observation_space, self.action_space):
                 raise ValueError(f"env has the spaces {observation_space} and {action_space}; "
@@ -398,6 +397,14 @@ class FQI:
         self.n_actions, self._observations = n_actions, observations
         self._collector = self._held = None
         self._data = None
+
+    def _check_action_input(self, observations, observation_space):
+        """ValueError if `action_input` is asked of observations that are not feature
+        vectors (`observations`: the format of `observation_space`)."""
+        if self.action_input and isinstance(observations, _ObjectRows):
+            raise ValueError(f"action_input needs feature-vector (Box) observations, not "
+                             f"{observation_space}: the action is appended to each "
+                             f"observation's features")
 
     def _check_regressor(self, observations, batch, n_actions):
         """Fit a clone of the regressor on `batch` (zero targets; distinct ones with
@@ -856,6 +863,7 @@ class FQI:
             if agent._q is not None and getattr(agent, name) != state[name]:
                 raise ValueError(f"{name} cannot change once the agent has a Q-function: "
                                  f"{path} holds one made with {name}={state[name]}")
+        agent._check_action_input(agent._observations, agent.observation_space)
         agent._env = agent._eval_env = agent._collector = agent._held = None
         agent._data = agent._logger = None
         env = agent.env if env is None else env

@@ -110,14 +110,15 @@ class _QFunction:
 class _ActionInputQFunction:
     """``Q_n`` as one regressor over each observation followed by its action's one-hot
     columns (FQI's ``action_input``): the actions share its splits on the observation, so
-    their Q-values err together and their differences, which choose the action, are
-    estimated more finely than by one regressor per action. Feature-vector observations.
+    their Q-values err together, where one regressor per action errs for each apart.
+    Feature-vector observations.
 
     Parameters
     ----------
     model : regressor
         Fitted on ``_with_actions(states, actions, n_actions)``.
     n_actions : int
+        The number of actions: one-hot columns after the observation's.
     iteration : int
         The iteration that fitted it (named in errors).
     """
@@ -154,9 +155,7 @@ class _ActionInputQFunction:
                                         f"({self.model!r})")
         return q.reshape(len(batch), self.n_actions)
 
-    def future(self, data, n_jobs=1, split=None):
-        """``max_a Q(s', a)`` for the next state of every transition of `data`."""
-        return self.values(data.next_states, n_jobs).max(axis=1)
+    future = _QFunction.future  # max_a Q(s', a) through `values`, as for one per action
 
     def backups(self, data, targets, discounts, n_backups, split=None):
         """`_QFunction.backups` on the one regressor: its leaves hold the mean targets of

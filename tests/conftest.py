@@ -44,6 +44,23 @@ THESIS_FOREST = dict(THESIS_TREE, bootstrap=False)
 
 
 @pytest.fixture
+def random_transitions():
+    """A factory of random FQI transitions: ``(n, n_features, n_actions, seed)``, normal
+    states, next states and rewards, uniform actions, 20 % of them terminal."""
+    import numpy as np
+
+    from fqi._collect import _Transitions
+
+    def make(n, n_features, n_actions, seed=0):
+        rng = np.random.default_rng(seed)
+        return _Transitions(rng.normal(size=(n, n_features)), rng.integers(n_actions, size=n),
+                            rng.normal(size=n), rng.normal(size=(n, n_features)),
+                            rng.random(n) < 0.2)
+
+    return make
+
+
+@pytest.fixture
 def cartpole_fqi():
     """A factory of small FQI agents on CartPole-v1 (rounds of 500 steps from 4 envs, 5
     backups a round, 3 leaf backups, 5 Extra-Trees, no evaluation, seed 0); its keyword

@@ -78,8 +78,11 @@ def test_predict_matches_numpy_reference_traversal(test_type, traversal_kernel):
     # unseen type 9 at predict time must match no test; sets of up to 16 objects and of more,
     # which the AVX-512 kernel walks differently, side by side; sets with more objects of a
     # type than it tests at once (16)
+    sized = [np.column_stack([rng.uniform(-5, 5, (k, 2)), rng.choice(types, k)])
+             for k, types in [(16, [0, 1, 2, 3]), (17, [0, 1, 2, 3]), (16, [0, 1, 3]),
+                              (17, [2]), (16, [9]), (15, [0, 1, 2, 3])]]
     X_new = (random_sets(rng, 300, n_types=10) + [np.empty((0, 3))]
-             + random_sets(rng, 100, max_objects=20)
+             + random_sets(rng, 100, max_objects=20) + sized
              + random_sets(rng, 50, max_objects=80, n_types=2))
     leaves = np.array([[reference_leaf(t, s) for t in trees] for s in X_new])
     expected = np.mean(

@@ -6,15 +6,9 @@ import pytest
 from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.linear_model import LinearRegression
 
+from boxtrees import BoxExtraTreesRegressor
 from fqi import FQI
-from fqi._collect import _Transitions
 from fqi._q_function import _ActionInputQFunction, _with_actions
-
-
-def _transitions(n, n_actions=3, seed=0):
-    rng = np.random.default_rng(seed)
-    return _Transitions(rng.normal(size=(n, 2)), rng.integers(n_actions, size=n),
-                        rng.normal(size=n), rng.normal(size=(n, 2)), rng.random(n) < 0.2)
 
 
 def test_the_input_is_the_observation_then_the_actions_one_hot_columns():
@@ -24,22 +18,26 @@ def test_the_input_is_the_observation_then_the_actions_one_hot_columns():
     assert joint.dtype == np.float32
 
 
-def test_one_regressor_fitted_on_every_transition_values_every_action():
-    data = _transitions(300)
-    targets = 2 * data.states[:, 0] - data.states[:, 1] + np.array([0.0, 1.5, -4.0])[
-        data.actions]
+def _linear_q(states):
+    """A Q-function linear in the state, with an offset per action (3 actions)."""
+    return (2 * states[:, :1] - states[:, 1:2]) + np.array([0.0, 1.5, -4.0])
+
+
+def test_one_regressor_fitted_on_every_transition_values_every_action(random_transitions):
+    data = random_transitions(300, 2, 3)
+    targets = _linear_q(data.states)[np.arange(300), data.actions]
     q = _ActionInputQFunction.fit(LinearRegression(), data, targets, 3,
                                   np.random.default_rng(0), None, 7)
     assert len(q.models) == 1 and q.iteration == 7
     assert q.models[0].n_features_in_ == 2 + 3
     probe = np.random.default_rng(1).normal(size=(20, 2))
-    expected = (2 * probe[:, :1] - probe[:, 1:]) + np.array([0.0, 1.5, -4.0])
-    np.testing.assert_allclose(q.values(probe), expected, atol=1e-9)
-    np.testing.assert_allclose(q.future(data), q.values(data.next_states).max(axis=1))
+    np.testing.assert_allclose(q.values(probe), _linear_q(probe), atol=1e-9)
+    np.testing.assert_allclose(q.future(data), _linear_q(data.next_states).max(axis=1),
+                               atol=1e-9)
 
 
-def test_leaf_backups_average_every_transitions_targets_in_the_one_forest():
-    data = _transitions(150)
+def test_leaf_backups_average_every_transitions_targets_in_the_one_forest(random_transitions):
+    data = random_transitions(150, 2, 3)
     rng = np.random.default_rng(1)
     fitted_on = rng.normal(size=150)
     forest = ExtraTreesRegressor(n_estimators=3, min_samples_split=10, random_state=0)
@@ -74,7 +72,7 @@ def test_action_input_repeats_with_its_seed_and_differs_from_a_regressor_per_act
     assert not np.allclose(per_action, first)
 
 
-def test_action_input_needs_feature_vectors_and_no_double(cartpole_fqi):
+def test_action_input_needs_feature_vectors_and_no_double(cartpole_fqi, tmp_path):
     with pytest.raises(ValueError, match="double and action_input cannot be combined"):
         cartpole_fqi(action_input=True, double=True)
     objects = gym.spaces.Sequence(gym.spaces.Box(-5.0, 5.0, shape=(3,)))
@@ -84,11 +82,34 @@ def test_action_input_needs_feature_vectors_and_no_double(cartpole_fqi):
 
         def reset(self, *, seed=None, options=None):
             super().reset(seed=seed)
-            return (np.zeros((1, 3), dtype=np.float32),), {}
+            return (np.array([1.0, -2.0, 0.0], dtype=np.float32),), {}
 
         def step(self, action):
-            return (np.zeros((1, 3), dtype=np.float32),), 0.0, False, False, {}
+            return (np.array([1.0, -2.0, 0.0], dtype=np.float32),), 0.0, False, False, {}
 
     with pytest.raises(ValueError, match="action_input needs feature-vector"):
         FQI(ExtraTreesRegressor(n_estimators=2), ObjectEnv(), action_input=True,
             eval_episodes=0, n_envs=1)
+    # nor can a saved agent on object sets take it up when loaded (without an env)
+    agent = FQI(BoxExtraTreesRegressor(n_estimators=2), ObjectEnv(), eval_episodes=0,
+                n_envs=1)
+    agent.save(tmp_path / "objects.joblib")
+    with pytest.raises(ValueError, match="action_input needs feature-vector"):
+        FQI.load(tmp_path / "objects.joblib", action_input=True)
+
+
+def test_action_input_learns_offline_from_a_mapping():
+    rng = np.random.default_rng(0)
+    x = rng.uniform(-2.4, 2.4, size=(500, 4)).astype(np.float32)
+    data = {"observations": x, "actions": rng.integers(0, 2, 500), "rewards": np.ones(500),
+            "next_observations": x[::-1], "terminations": np.abs(x[:, 0]) > 2}
+    agent = FQI(ExtraTreesRegressor(n_estimators=5, random_state=0), "CartPole-v1",
+                action_input=True, eval_episodes=0, seed=0)
+    agent.learn_offline(data, n_iterations=3)
+    (model,) = agent.q_functions_
+    assert model.n_features_in_ == 4 + 2 and len(agent.history) == 3
+    q = agent.q_values(x[:10])
+    one_hot = np.tile(np.float32([0, 1]), (10, 1))
+    np.testing.assert_array_equal(q[:, 1], model.predict(np.hstack([x[:10], one_hot])))
+    # three fits of a reward of 1 per step: values between 1 and 1 + 0.99 + 0.99 ** 2
+    assert (q >= 1 - 1e-9).all() and (q <= 1 + 0.99 + 0.99**2 + 1e-9).all()

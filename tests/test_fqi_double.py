@@ -6,14 +6,7 @@ import pytest
 from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.linear_model import Ridge
 
-from fqi._collect import _Transitions
 from fqi._q_function import _crossed, _DoubleQFunction, _QFunction
-
-
-def _transitions(n, seed=0):
-    rng = np.random.default_rng(seed)
-    return _Transitions(rng.normal(size=(n, 3)), rng.integers(2, size=n), rng.normal(size=n),
-                        rng.normal(size=(n, 3)), rng.random(n) < 0.2)
 
 
 def test_crossed_values_take_the_other_halfs_value_of_the_own_halfs_best_action():
@@ -24,8 +17,8 @@ def test_crossed_values_take_the_other_halfs_value_of_the_own_halfs_best_action(
     np.testing.assert_array_equal(_crossed(first, second, split), [0.5, 1.0, 3.0])
 
 
-def test_each_half_is_fitted_on_its_own_transitions_only():
-    data = _transitions(200)
+def test_each_half_is_fitted_on_its_own_transitions_only(random_transitions):
+    data = random_transitions(200, 3, 2)
     targets = np.random.default_rng(1).normal(size=200)
     split = np.random.default_rng(2).random(200) < 0.5
     q = _DoubleQFunction.fit(Ridge(), data, targets, 2, np.random.default_rng(0), None, 3,
@@ -44,8 +37,8 @@ def test_each_half_is_fitted_on_its_own_transitions_only():
                                         split))
 
 
-def test_double_leaf_backups_hold_each_halfs_own_targets():
-    data = _transitions(160)
+def test_double_leaf_backups_hold_each_halfs_own_targets(random_transitions):
+    data = random_transitions(160, 3, 2)
     rng = np.random.default_rng(1)
     split = rng.random(160) < 0.5
     fitted_on = rng.normal(size=160)
