@@ -1,0 +1,144 @@
+"""Acrobot-v1: exploratory FQI settings against the tuned DQN, in environment steps to -100.
+
+FQI with grown-out Extra-Trees on the registry's leaf-backup setting (20 `leaf_backups`, 4
+envs), random actions held for zeta(3)-distributed durations, and one forest over the
+observation and the action (``action_input``) or one per action (``--per-action``), learns
+on the schedule of a 100,000-step run and stops at ``--stop`` steps. Every 5,000 steps its
+greedy policy plays 20 held-out episodes, as the registry's ``control`` kind scores its runs
+(`benchmarks.training.EvalCallback` on a synchronous vector env, `fqi.evaluate`'s default
+seeds). Printed and written per seed: the curve and the first evaluation at or above -100;
+beside them, the same figure of the registry's tuned DQN runs when they are cached under
+``--results`` (``control_acrobot``).
+
+    python -m benchmarks.bench_acrobot --seeds 0 1 2 3 4 --trees 150 --out docs/results/acrobot
+    python -m benchmarks.bench_acrobot --seeds 0 --trees 5 --stop 1000 --out /tmp/acrobot
+
+Writes ``bench_acrobot.json`` and ``bench_acrobot.png`` (return against steps) under
+``--out``; seeds run in parallel processes (``--jobs``), one core each.
+"""
+import argparse
+import json
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+from joblib import Parallel, delayed
+from sklearn.ensemble import ExtraTreesRegressor
+from stable_baselines3.common.callbacks import BaseCallback
+
+from fqi import FQI
+
+from .training import EvalCallback, timed_learn
+
+ENV, THRESHOLD, BUDGET, EVAL_EVERY, EVAL_EPISODES = "Acrobot-v1", -100.0, 100_000, 5000, 20
+DQN_RUNS = Path("runs/full/control_acrobot/DQN_rl-zoo3")  # under --results
+
+
+class _StopAt(BaseCallback):
+    """Ends `learn` once the model has taken `steps` environment steps."""
+
+    def __init__(self, steps):
+        super().__init__()
+        self.steps = steps
+
+    def _on_step(self):
+        return self.num_timesteps < self.steps
+
+
+def first_crossing(curve, threshold=THRESHOLD):
+    """The steps of the first ``[steps, mean return]`` of `curve` at or above `threshold`,
+    or None."""
+    return next((int(steps) for steps, value in curve if value >= threshold), None)
+
+
+def run_seed(seed, n_trees, stop, action_input):
+    """One FQI run; its curve, first crossing and training seconds."""
+    agent = FQI(ExtraTreesRegressor(n_estimators=n_trees), ENV, action_input=action_input,
+                leaf_backups=20, n_envs=4, exploration_zeta=3, eval_episodes=0, seed=seed)
+    evaluation = gym.make_vec(ENV, EVAL_EPISODES, vectorization_mode="sync")
+    curve = EvalCallback(evaluation, EVAL_EVERY, n_episodes=EVAL_EPISODES)
+    seconds, _ = timed_learn(agent, [curve, _StopAt(stop)], total_timesteps=BUDGET)
+    evaluation.close()
+    return {"seed": seed, "curve": curve.evaluations,
+            "first_crossing": first_crossing(curve.evaluations), "train_seconds": seconds}
+
+
+def dqn_crossings(results):
+    """Seed -> first crossing of the registry's cached tuned-DQN runs (empty without them)."""
+    return {int(path.stem.removeprefix("seed")):
+            first_crossing(json.loads(path.read_text())["result"]["curve"])
+            for path in sorted((Path(results) / DQN_RUNS).glob("seed*.json"))}
+
+
+def _median(crossings):
+    """The median first crossing, a run that never crossed counting as later than all
+    (``inf``); None without runs."""
+    steps = sorted(np.inf if c is None else c for c in crossings)
+    return steps[len(steps) // 2] if steps else None
+
+
+def _steps(value):
+    """A median for the JSON file: None when not reached (or no runs)."""
+    return None if value is None or value == np.inf else int(value)
+
+
+def plot(runs, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for run in runs:
+        steps, values = zip(*run["curve"])
+        ax.plot(steps, values, marker="o", label=f"seed {run['seed']}")
+    ax.axhline(THRESHOLD, color="k", ls="--", lw=1, label="threshold")
+    ax.set(xlabel="environment steps", ylabel="mean return (20 held-out episodes)",
+           title=f"FQI on {ENV}", ylim=(-510, -50))
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3, 4])
+    parser.add_argument("--trees", type=int, default=150)
+    parser.add_argument("--stop", type=int, default=25_000, help="steps at which to stop")
+    parser.add_argument("--per-action", action="store_true",
+                        help="a forest per action instead of action_input")
+    parser.add_argument("--jobs", type=int, default=2, help="seeds run in parallel")
+    parser.add_argument("--results", default="docs/results",
+                        help="the registry's results folder, for the DQN runs")
+    parser.add_argument("--out", default="results/acrobot")
+    args = parser.parse_args(argv)
+    runs = Parallel(n_jobs=args.jobs)(
+        delayed(run_seed)(seed, args.trees, args.stop, not args.per_action)
+        for seed in args.seeds)
+    dqn = dqn_crossings(args.results)
+    print(f"{'seed':>4} {'first past -100':>16} {'DQN':>8} {'train s':>8}  curve")
+    for run in runs:
+        crossing = run["first_crossing"]
+        print(f"{run['seed']:>4} {crossing or 'not':>16} {dqn.get(run['seed']) or '-':>8} "
+              f"{run['train_seconds']:>8.0f}  "
+              + " ".join(f"{value:.1f}" for _, value in run["curve"]))
+    fqi_median = _median([run["first_crossing"] for run in runs])
+    dqn_median = _median(list(dqn.values()))
+    print(f"median first crossing: FQI {_steps(fqi_median)}, DQN {_steps(dqn_median)} "
+          f"(None: not reached)")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    summary = {"env": ENV, "threshold": THRESHOLD, "budget": BUDGET, "stop": args.stop,
+               "trees": args.trees, "action_input": not args.per_action,
+               "fqi_median": _steps(fqi_median), "dqn_first_crossing": dqn,
+               "dqn_median": _steps(dqn_median),
+               "runs": runs}
+    (out / "bench_acrobot.json").write_text(json.dumps(summary, indent=1))
+    plot(runs, out / "bench_acrobot.png")
+    print(f"wrote {out / 'bench_acrobot.json'} and {out / 'bench_acrobot.png'}")
+    return summary
+
+
+if __name__ == "__main__":
+    main()
