@@ -354,6 +354,29 @@ static int64_t boxtrees_compact_columns_avx2(const float *xs, const float *ys,
                                                  n_extra, out + k);
 }
 
+/* Lanes 0 to min(n, 16) - 1: the live entries of a step with n entries left. */
+static inline __mmask16 boxtrees_lanes16(int64_t n)
+{
+    return n >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << n) - 1u);
+}
+
+/* The lanes whose x lies in (x0, x1) and y in (y0, y1). */
+__attribute__((target("avx512f")))
+static inline __mmask16 boxtrees_in_box_avx512(__m512 x, __m512 y, __m512 x0, __m512 x1,
+                                               __m512 y0, __m512 y1)
+{
+    return _mm512_cmp_ps_mask(x, x0, _CMP_GT_OQ) & _mm512_cmp_ps_mask(x, x1, _CMP_LT_OQ)
+           & _mm512_cmp_ps_mask(y, y0, _CMP_GT_OQ) & _mm512_cmp_ps_mask(y, y1, _CMP_LT_OQ);
+}
+
+/* The lanes of x and y inside node `n`'s box. */
+__attribute__((target("avx512f")))
+static inline __mmask16 boxtrees_in_node_box_avx512(const boxtrees_node *n, __m512 x, __m512 y)
+{
+    return boxtrees_in_box_avx512(x, y, _mm512_set1_ps(n->box[0]), _mm512_set1_ps(n->box[1]),
+                                  _mm512_set1_ps(n->box[2]), _mm512_set1_ps(n->box[3]));
+}
+
 __attribute__((target("avx512f")))
 static int64_t boxtrees_compact_box_avx512(const float *xs, const float *ys, const int32_t *sid,
                                            int64_t n, float xmin, float xmax, float ymin,
@@ -363,10 +386,9 @@ static int64_t boxtrees_compact_box_avx512(const float *xs, const float *ys, con
     const __m512 y0 = _mm512_set1_ps(ymin), y1 = _mm512_set1_ps(ymax);
     int64_t j = 0, k = 0;
     for (; j < n; j += 16) {
-        __mmask16 live = n - j >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << (n - j)) - 1u);
+        __mmask16 live = boxtrees_lanes16(n - j);
         __m512 x = _mm512_maskz_loadu_ps(live, xs + j), y = _mm512_maskz_loadu_ps(live, ys + j);
-        __mmask16 m = live & _mm512_cmp_ps_mask(x, x0, _CMP_GT_OQ) & _mm512_cmp_ps_mask(x, x1, _CMP_LT_OQ)
-                      & _mm512_cmp_ps_mask(y, y0, _CMP_GT_OQ) & _mm512_cmp_ps_mask(y, y1, _CMP_LT_OQ);
+        __mmask16 m = live & boxtrees_in_box_avx512(x, y, x0, x1, y0, y1);
         __m512i s = _mm512_maskz_loadu_epi32(live, (const void *)(sid + j));
         _mm512_storeu_si512((void *)(out + k), _mm512_maskz_compress_epi32(m, s));
         k += __builtin_popcount((unsigned)m);
@@ -405,10 +427,9 @@ static int64_t boxtrees_compact_columns_avx512(const float *xs, const float *ys,
     const __m512 y0 = _mm512_set1_ps(box[2]), y1 = _mm512_set1_ps(box[3]);
     int64_t k = 0;
     for (int64_t j = 0; j < n; j += 16) {
-        __mmask16 live = n - j >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << (n - j)) - 1u);
+        __mmask16 live = boxtrees_lanes16(n - j);
         __m512 x = _mm512_maskz_loadu_ps(live, xs + j), y = _mm512_maskz_loadu_ps(live, ys + j);
-        unsigned m = live & _mm512_cmp_ps_mask(x, x0, _CMP_GT_OQ) & _mm512_cmp_ps_mask(x, x1, _CMP_LT_OQ)
-                     & _mm512_cmp_ps_mask(y, y0, _CMP_GT_OQ) & _mm512_cmp_ps_mask(y, y1, _CMP_LT_OQ);
+        unsigned m = live & boxtrees_in_box_avx512(x, y, x0, x1, y0, y1);
         for (unsigned rest = m; rest; rest &= rest - 1) {
             int lane = __builtin_ctz(rest);
             if (!boxtrees_extra_inside(attributes + (int64_t)oid[j + lane] * n_attributes,
@@ -470,13 +491,9 @@ static inline const boxtrees_node *boxtrees_next_avx512(const boxtrees_node *nod
     const float *x = features + n->x_column * stride, *y = features + n->y_column * stride;
     int64_t k = types[n->object_type], end = types[n->object_type + 1];
     do {    /* one pass for up to 16 objects (and for none) */
-        __mmask16 live = end - k >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << (end - k)) - 1u);
+        __mmask16 live = boxtrees_lanes16(end - k);
         __m512 xs = _mm512_maskz_loadu_ps(live, x + k), ys = _mm512_maskz_loadu_ps(live, y + k);
-        __mmask16 in = live & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[0]), _CMP_GT_OQ)
-                       & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[1]), _CMP_LT_OQ)
-                       & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[2]), _CMP_GT_OQ)
-                       & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[3]), _CMP_LT_OQ);
-        count += __builtin_popcount((unsigned)in);
+        count += __builtin_popcount((unsigned)(live & boxtrees_in_node_box_avx512(n, xs, ys)));
         k += 16;
     } while (k < end);
     return nodes + (count < n->threshold ? n->left : n->right);
@@ -503,10 +520,7 @@ static inline const boxtrees_node *boxtrees_next16_avx512(const boxtrees_node *n
     __mmask16 of_type = (__mmask16)(((1u << hi) - 1u) & ~((1u << lo) - 1u));
     __m512 xs = _mm512_maskz_loadu_ps(live, features + n->x_column * stride + base);
     __m512 ys = _mm512_maskz_loadu_ps(live, features + n->y_column * stride + base);
-    __mmask16 in = of_type & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[0]), _CMP_GT_OQ)
-                   & _mm512_cmp_ps_mask(xs, _mm512_set1_ps(n->box[1]), _CMP_LT_OQ)
-                   & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[2]), _CMP_GT_OQ)
-                   & _mm512_cmp_ps_mask(ys, _mm512_set1_ps(n->box[3]), _CMP_LT_OQ);
+    __mmask16 in = of_type & boxtrees_in_node_box_avx512(n, xs, ys);
     int32_t count = __builtin_popcount((unsigned)in);
     return nodes + (count < n->threshold ? n->left : n->right);
 }
@@ -530,8 +544,7 @@ static inline void boxtrees_walk_avx512(const boxtrees_node *nodes,
         at[w] = nodes;
         ts[w] = types + ids[w] * types_stride;
         base[w] = ts[w][0];
-        live[w] = short_sets ? (__mmask16)((1u << (ts[w][types_stride - 1] - base[w])) - 1u)
-                             : 0;
+        live[w] = short_sets ? boxtrees_lanes16(ts[w][types_stride - 1] - base[w]) : 0;
     }
     int walking;
     do {
