@@ -28,7 +28,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from fqi import FQI
 
-from .training import EvalCallback, timed_learn
+from .training import EvalCallback, steps_to_threshold, timed_learn
 
 ENV, THRESHOLD, BUDGET, EVAL_EVERY, EVAL_EPISODES = "Acrobot-v1", -100.0, 100_000, 5000, 20
 DQN_RUNS = Path("runs/full/control_acrobot/DQN_rl-zoo3")  # under --results
@@ -45,12 +45,6 @@ class _StopAt(BaseCallback):
         return self.num_timesteps < self.steps
 
 
-def first_crossing(curve, threshold=THRESHOLD):
-    """The steps of the first ``[steps, mean return]`` of `curve` at or above `threshold`,
-    or None."""
-    return next((int(steps) for steps, value in curve if value >= threshold), None)
-
-
 def run_seed(seed, n_trees, stop, action_input):
     """One FQI run; its curve, first crossing and training seconds."""
     agent = FQI(ExtraTreesRegressor(n_estimators=n_trees), ENV, action_input=action_input,
@@ -60,13 +54,14 @@ def run_seed(seed, n_trees, stop, action_input):
     seconds, _ = timed_learn(agent, [curve, _StopAt(stop)], total_timesteps=BUDGET)
     evaluation.close()
     return {"seed": seed, "curve": curve.evaluations,
-            "first_crossing": first_crossing(curve.evaluations), "train_seconds": seconds}
+            "first_crossing": steps_to_threshold(curve.evaluations, THRESHOLD),
+            "train_seconds": seconds}
 
 
 def dqn_crossings(results):
     """Seed -> first crossing of the registry's cached tuned-DQN runs (empty without them)."""
     return {int(path.stem.removeprefix("seed")):
-            first_crossing(json.loads(path.read_text())["result"]["curve"])
+            json.loads(path.read_text())["result"]["steps_to_threshold"]
             for path in sorted((Path(results) / DQN_RUNS).glob("seed*.json"))}
 
 

@@ -47,7 +47,7 @@ from tqdm.auto import tqdm
 
 from fqi import FQI, evaluate, make_box_forest
 
-from .training import EvalCallback, timed_learn, train_sb3
+from .training import EvalCallback, steps_to_threshold, timed_learn, train_sb3
 from .zoo_hyperparams import ZOO_DQN
 
 # Tuned DQN: rl-zoo3's settings for each env (benchmarks/zoo_hyperparams.py; policy
@@ -101,8 +101,7 @@ def run(env_id, agent_name, seed, steps, every):
         seconds, cpu_seconds = run_dqn(env_id, seed, steps, curve)
     else:
         seconds, cpu_seconds = run_fqi(env_id, agent_name, seed, steps, curve)
-    threshold = ENVS[env_id]["threshold"]
-    solved = next((s for s, mean in curve.evaluations if mean >= threshold), None)
+    solved = steps_to_threshold(curve.evaluations, ENVS[env_id]["threshold"])
     return {"env": env_id, "agent": agent_name, "seed": seed,
             "env_steps": curve.evaluations[-1][0], "curve": curve.evaluations,
             "final_mean": curve.evaluations[-1][1], "steps_to_threshold": solved,

@@ -24,8 +24,8 @@ from stable_baselines3.common.vec_env import VecNormalize
 
 from fqi import evaluate
 
-__all__ = ["ALGORITHMS", "train_sb3", "timed_learn", "EvalCallback", "WrappedPolicy",
-           "torch_threads"]
+__all__ = ["ALGORITHMS", "train_sb3", "timed_learn", "EvalCallback", "steps_to_threshold",
+           "WrappedPolicy", "torch_threads"]
 
 ALGORITHMS = {"DQN": DQN, "PPO": PPO}
 
@@ -121,6 +121,14 @@ class EvalCallback(BaseCallback):
         self._due = (self.num_timesteps // self.eval_freq + 1) * self.eval_freq
         if self.verbose:
             print(f"{self.num_timesteps:,} steps: {self.score} return {value:,.1f}")
+
+
+def steps_to_threshold(evaluations, threshold):
+    """The steps of the first ``[steps, score]`` of `evaluations` (an `EvalCallback`'s)
+    scoring at least `threshold`; None if none does, or if `threshold` is None."""
+    if threshold is None:
+        return None
+    return next((steps for steps, score in evaluations if score >= threshold), None)
 
 
 def timed_learn(model, callback=None, **learn_kwargs):

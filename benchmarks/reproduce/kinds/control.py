@@ -73,7 +73,8 @@ class Control(UnitKind):
     budget_fields = ("control_scale",)
 
     def run(self, unit, checkpoint=None):
-        from ...training import EvalCallback, timed_learn, train_sb3  # imports torch
+        from ...training import (  # imports torch
+            EvalCallback, steps_to_threshold, timed_learn, train_sb3)
 
         settings, scale = unit.settings, unit.budget.control_scale
         steps = max(1, round(settings.steps * scale))
@@ -95,11 +96,9 @@ class Control(UnitKind):
                 done = model.num_timesteps
         finally:
             evaluation.close()
-        threshold = settings.threshold
-        solved = next((s for s, mean in curve.evaluations
-                       if threshold is not None and mean >= threshold), None)
         return {"reward": curve.evaluations[-1][1], "curve": curve.evaluations,
-                "steps_to_threshold": solved, "total_timesteps": int(done),
+                "steps_to_threshold": steps_to_threshold(curve.evaluations,
+                                                         settings.threshold), "total_timesteps": int(done),
                 "train_seconds": seconds, "train_cpu_seconds": cpu_seconds,
                 "eval_seconds": curve.eval_seconds}
 
