@@ -24,25 +24,13 @@ import gymnasium as gym
 import numpy as np
 from joblib import Parallel, delayed
 from sklearn.ensemble import ExtraTreesRegressor
-from stable_baselines3.common.callbacks import BaseCallback
 
 from fqi import FQI
 
-from .training import EvalCallback, steps_to_threshold, timed_learn
+from .training import EvalCallback, StopAt, steps_to_threshold, timed_learn
 
 ENV, THRESHOLD, BUDGET, EVAL_EVERY, EVAL_EPISODES = "Acrobot-v1", -100.0, 100_000, 5000, 20
 DQN_RUNS = Path("runs/full/control_acrobot/DQN_rl-zoo3")  # under --results
-
-
-class _StopAt(BaseCallback):
-    """Ends `learn` once the model has taken `steps` environment steps."""
-
-    def __init__(self, steps):
-        super().__init__()
-        self.steps = steps
-
-    def _on_step(self):
-        return self.num_timesteps < self.steps
 
 
 def run_seed(seed, n_trees, stop, action_input):
@@ -51,7 +39,7 @@ def run_seed(seed, n_trees, stop, action_input):
                 leaf_backups=20, n_envs=4, exploration_zeta=3, eval_episodes=0, seed=seed)
     evaluation = gym.make_vec(ENV, EVAL_EPISODES, vectorization_mode="sync")
     curve = EvalCallback(evaluation, EVAL_EVERY, n_episodes=EVAL_EPISODES)
-    seconds, _ = timed_learn(agent, [curve, _StopAt(stop)], total_timesteps=BUDGET)
+    seconds, _ = timed_learn(agent, [curve, StopAt(stop)], total_timesteps=BUDGET)
     evaluation.close()
     return {"seed": seed, "curve": curve.evaluations,
             "first_crossing": steps_to_threshold(curve.evaluations, THRESHOLD),

@@ -24,8 +24,8 @@ from stable_baselines3.common.vec_env import VecNormalize
 
 from fqi import evaluate
 
-__all__ = ["ALGORITHMS", "train_sb3", "timed_learn", "EvalCallback", "steps_to_threshold",
-           "WrappedPolicy", "torch_threads"]
+__all__ = ["ALGORITHMS", "train_sb3", "timed_learn", "EvalCallback", "StopAt",
+           "steps_to_threshold", "WrappedPolicy", "torch_threads"]
 
 ALGORITHMS = {"DQN": DQN, "PPO": PPO}
 
@@ -121,6 +121,19 @@ class EvalCallback(BaseCallback):
         self._due = (self.num_timesteps // self.eval_freq + 1) * self.eval_freq
         if self.verbose:
             print(f"{self.num_timesteps:,} steps: {self.score} return {value:,.1f}")
+
+
+class StopAt(BaseCallback):
+    """Ends ``learn`` once the model has taken `steps` environment steps: a run on the
+    schedule of a longer ``total_timesteps`` (its exploration decays as in that run), cut
+    short. Put it after an `EvalCallback` in the list, so that the last step is scored."""
+
+    def __init__(self, steps):
+        super().__init__()
+        self.steps = steps
+
+    def _on_step(self):
+        return self.num_timesteps < self.steps
 
 
 def steps_to_threshold(evaluations, threshold):

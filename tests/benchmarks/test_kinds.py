@@ -147,6 +147,10 @@ def test_reference_policies_score_on_the_reference_worlds_as_learners_do():
                  "fqi": {"epsilon": 0.1}}, "fqi takes no argument epsilon"),
     ("control", {"env_id": "CartPole-v1", "learner": "fqi", "steps": 10,
                  "fqi": {"seed": 1}}, "fqi takes no argument seed"),
+    ("control", {"env_id": "CartPole-v1", "learner": "fqi", "steps": 10, "stop": 11},
+     r"stop must be None or a whole number from 1 to steps \(10\), got 11"),
+    ("control", {"env_id": "CartPole-v1", "learner": "DQN", "steps": 10, "stop": 0.5},
+     "stop must be None or a whole number"),
 ])
 def test_a_settings_mistake_is_named(kind, params, match):
     with pytest.raises(ValueError, match=match):
@@ -187,6 +191,26 @@ def test_a_kind_is_one_class_that_registers_itself(tmp_path):
         assert stats.score == 7.0 and stats.n_runs == 1
     finally:
         del KINDS["constant"]
+
+
+def test_a_stopped_control_run_ends_at_its_stop_on_the_schedule_of_its_steps(tmp_path):
+    """``stop`` cuts the run short after the round that reaches it; epsilon still decays over
+    ``steps``, so a stopped run is the start of the full one."""
+    fqi = {"samples_per_iteration": 100, "n_envs": 1, "resample_every": 1,
+           "exploration_fraction": 1.0, "exploration_final_eps": 0.0}
+    common = {"env_id": "CartPole-v1", "learner": "fqi", "steps": 1000,
+              "regressor": "extra-trees", "fqi": fqi, "eval_every": 100, "eval_episodes": 2}
+    experiment = Experiment("stopped", "extra", "Stopped", "control", on_demand=True,
+                            settings={"full": common, "stopped": {**common, "stop": 300}})
+    full_budget = replace(TINY, control_scale=1.0)
+    results = {}
+    for label in experiment.settings:
+        unit, = setting_units(experiment, label, full_budget, tmp_path)
+        results[label] = run_unit(unit)
+    stopped, full = results["stopped"], results["full"]
+    assert stopped["total_timesteps"] == 300 and full["total_timesteps"] == 1000
+    assert [steps for steps, _ in stopped["curve"]] == [100, 200, 300]
+    assert stopped["curve"] == full["curve"][:3]
 
 
 def test_gymnasium_tasks_run_each_learner_and_report_its_steps_to_the_threshold(tmp_path):

@@ -156,14 +156,14 @@ def test_the_control_runs_measured_fqis_current_defaults():
     assert {name: defaults[name] for name in FQI_DEFAULTS_MEASURED} == FQI_DEFAULTS_MEASURED
 
 
-@pytest.mark.parametrize("name, first_ties, held", [("control_cartpole", True, False),
-                                                     ("control_acrobot", True, False),
-                                                     ("control_mountaincar", False, True),
-                                                     ("control_lunarlander", False, False)])
-def test_first_action_tie_runs_only_where_they_were_made(name, first_ties, held):
+@pytest.mark.parametrize("name, first_ties, held, action_input", [
+    ("control_cartpole", True, False, False), ("control_acrobot", True, False, True),
+    ("control_mountaincar", False, True, False), ("control_lunarlander", False, False, False)])
+def test_first_action_tie_runs_only_where_they_were_made(name, first_ties, held, action_input):
     """The envs run before `tie_break` existed keep those runs beside the new default's; the
     others run each FQI setting once, with ties broken at random; MountainCar alone adds a
-    setting with held random actions."""
+    setting with held random actions, Acrobot one forest over observation and action that
+    stops at half DQN's budget."""
     labels = list(REGISTRY[name].settings)
     tied = [label for label in labels if label.endswith(", first-action ties")]
     assert len(tied) == (3 if first_ties else 0)
@@ -171,5 +171,11 @@ def test_first_action_tie_runs_only_where_they_were_made(name, first_ties, held)
     assert len(held_labels) == held
     for label in held_labels:
         assert REGISTRY[name].settings[label]["fqi"]["exploration_zeta"] == 1.5
-    assert sum(label.startswith("FQI") for label in labels) == 4 + 3 * first_ties + held
+    stopped = [label for label in labels if "stop" in REGISTRY[name].params(label)]
+    assert len(stopped) == action_input
+    for label in stopped:
+        params = REGISTRY[name].params(label)
+        assert params["fqi"]["action_input"] and params["stop"] * 2 == params["steps"]
+    assert sum(label.startswith("FQI") for label in labels) == (4 + 3 * first_ties + held
+                                                                + action_input)
     assert {"DQN (rl-zoo3)", "PPO (rl-zoo3)"} <= set(labels)

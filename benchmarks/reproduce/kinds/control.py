@@ -16,12 +16,14 @@ from ._base import UnitKind, fmt
 
 __all__ = ["Control", "REGRESSORS", "training_minutes"]
 
-# The Extra-Trees of the FQI agents: 30 trees, nodes of fewer than 10 samples are leaves (or
-# scikit-learn's default of 2: grown out), one job (so that every learner gets one core).
+# The Extra-Trees of the FQI agents: 30 trees (or 150), nodes of fewer than 10 samples are
+# leaves (or scikit-learn's default of 2: grown out), one job (so that every learner gets one
+# core).
 REGRESSORS = {
     "extra-trees": lambda: ExtraTreesRegressor(n_estimators=30, min_samples_split=10,
                                                n_jobs=1),
     "extra-trees, grown out": lambda: ExtraTreesRegressor(n_estimators=30, n_jobs=1),
+    "extra-trees, 150 grown out": lambda: ExtraTreesRegressor(n_estimators=150, n_jobs=1),
     "box-classic": lambda: make_box_forest(test_type="classic", n_estimators=30, n_tests=10,
                                            min_samples_split=10, n_jobs=1),
 }
@@ -36,8 +38,10 @@ class ControlSettings:
     """``env_id`` (a registered gymnasium id), ``learner`` ("fqi", "DQN" or "PPO"),
     ``steps`` (environment steps at full size), for FQI its ``regressor`` (a name of
     `REGRESSORS`) and ``fqi`` (`fqi.FQI` arguments other than its defaults), for SB3 its
-    ``hyperparams`` (rl-zoo3's form, `training.train_sb3`); the evaluation: ``eval_episodes``
-    held-out episodes every ``eval_every`` steps; ``threshold``: the task's solved score."""
+    ``hyperparams`` (rl-zoo3's form, `training.train_sb3`); ``stop``: end the run after this
+    many of its ``steps`` (None: run them all; schedules such as the exploration's still
+    span ``steps``); the evaluation: ``eval_episodes`` held-out episodes every
+    ``eval_every`` steps; ``threshold``: the task's solved score."""
 
     env_id: str
     learner: str = None
@@ -45,6 +49,7 @@ class ControlSettings:
     regressor: str = "extra-trees"
     fqi: dict = field(default_factory=dict)
     hyperparams: dict = field(default_factory=dict)
+    stop: int = None
     eval_every: int = 5000
     eval_episodes: int = 20
     threshold: float = None
@@ -57,6 +62,10 @@ class ControlSettings:
                              f"{self.regressor!r}")
         if not isinstance(self.steps, int) or self.steps < 1:
             raise ValueError(f"steps must be a whole number >= 1, got {self.steps!r}")
+        if self.stop is not None and not (isinstance(self.stop, int)
+                                          and 1 <= self.stop <= self.steps):
+            raise ValueError(f"stop must be None or a whole number from 1 to steps "
+                             f"({self.steps}), got {self.stop!r}")
         unknown = sorted(set(self.fqi) - _FQI_SETTABLE)
         if unknown:
             raise ValueError(f"fqi takes no argument {', '.join(unknown)} here (the kind sets "
@@ -74,7 +83,7 @@ class Control(UnitKind):
 
     def run(self, unit, checkpoint=None):
         from ...training import (  # imports torch
-            EvalCallback, steps_to_threshold, timed_learn, train_sb3)
+            EvalCallback, StopAt, steps_to_threshold, timed_learn, train_sb3)
 
         settings, scale = unit.settings, unit.budget.control_scale
         steps = max(1, round(settings.steps * scale))
@@ -82,17 +91,19 @@ class Control(UnitKind):
                                   vectorization_mode="sync")
         curve = EvalCallback(evaluation, max(1, round(settings.eval_every * scale)),
                              n_episodes=settings.eval_episodes)
+        callback = curve if settings.stop is None else [
+            curve, StopAt(max(1, round(settings.stop * scale)))]
         try:
             if settings.learner == "fqi":
                 agent = FQI(REGRESSORS[settings.regressor](), settings.env_id,
                             eval_episodes=0, seed=unit.seed, **settings.fqi)
-                seconds, cpu_seconds = timed_learn(agent, curve, total_timesteps=steps)
+                seconds, cpu_seconds = timed_learn(agent, callback, total_timesteps=steps)
                 done = agent.num_timesteps
                 agent.get_env().close()
             else:
                 model, seconds, cpu_seconds = train_sb3(
                     settings.learner, lambda: gym.make(settings.env_id), steps,
-                    settings.hyperparams, seed=unit.seed, callback=curve)
+                    settings.hyperparams, seed=unit.seed, callback=callback)
                 done = model.num_timesteps
         finally:
             evaluation.close()
@@ -103,7 +114,9 @@ class Control(UnitKind):
                 "eval_seconds": curve.eval_seconds}
 
     def cost(self, unit):
-        return _SECONDS_PER_STEP * unit.settings.steps * unit.budget.control_scale
+        settings = unit.settings
+        steps = settings.steps if settings.stop is None else settings.stop
+        return _SECONDS_PER_STEP * steps * unit.budget.control_scale
 
     def record_shape(self, budget):
         return {"reward": float, "curve": ListOf(ListOf(float, 2))}
