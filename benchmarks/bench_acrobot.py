@@ -21,13 +21,12 @@ import json
 from pathlib import Path
 
 import gymnasium as gym
-import numpy as np
 from joblib import Parallel, delayed
 from sklearn.ensemble import ExtraTreesRegressor
 
 from fqi import FQI
 
-from .training import EvalCallback, StopAt, steps_to_threshold, timed_learn
+from .training import EvalCallback, StopAt, median_steps, steps_to_threshold, timed_learn
 
 ENV, THRESHOLD, BUDGET, EVAL_EVERY, EVAL_EPISODES = "Acrobot-v1", -100.0, 100_000, 5000, 20
 DQN_RUNS = Path("runs/full/control_acrobot/DQN_rl-zoo3")  # under --results
@@ -51,18 +50,6 @@ def dqn_crossings(results):
     return {int(path.stem.removeprefix("seed")):
             json.loads(path.read_text())["result"]["steps_to_threshold"]
             for path in sorted((Path(results) / DQN_RUNS).glob("seed*.json"))}
-
-
-def _median(crossings):
-    """The median first crossing, a run that never crossed counting as later than all
-    (``inf``); None without runs."""
-    steps = sorted(np.inf if c is None else c for c in crossings)
-    return steps[len(steps) // 2] if steps else None
-
-
-def _steps(value):
-    """A median for the JSON file: None when not reached (or no runs)."""
-    return None if value is None or value == np.inf else int(value)
 
 
 def plot(runs, path):
@@ -106,16 +93,17 @@ def main(argv=None):
         print(f"{run['seed']:>4} {crossing or 'not':>16} {dqn.get(run['seed']) or '-':>8} "
               f"{run['train_seconds']:>8.0f}  "
               + " ".join(f"{value:.1f}" for _, value in run["curve"]))
-    fqi_median = _median([run["first_crossing"] for run in runs])
-    dqn_median = _median(list(dqn.values()))
-    print(f"median first crossing: FQI {_steps(fqi_median)}, DQN {_steps(dqn_median)} "
-          f"(None: not reached)")
+    fqi_median = median_steps([run["first_crossing"] for run in runs])
+    dqn_median = median_steps(list(dqn.values()))
+    print("median first crossing: "
+          + ", ".join(f"{who} {'not reached' if steps is None else f'{steps:,.0f}'}"
+                      for who, steps in (("FQI", fqi_median), ("DQN", dqn_median))))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     summary = {"env": ENV, "threshold": THRESHOLD, "budget": BUDGET, "stop": args.stop,
                "trees": args.trees, "action_input": not args.per_action,
-               "fqi_median": _steps(fqi_median), "dqn_first_crossing": dqn,
-               "dqn_median": _steps(dqn_median),
+               "fqi_median": fqi_median, "dqn_first_crossing": dqn,
+               "dqn_median": dqn_median,
                "runs": runs}
     (out / "bench_acrobot.json").write_text(json.dumps(summary, indent=1))
     plot(runs, out / "bench_acrobot.png")

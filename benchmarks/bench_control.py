@@ -47,7 +47,7 @@ from tqdm.auto import tqdm
 
 from fqi import FQI, evaluate, make_box_forest
 
-from .training import EvalCallback, steps_to_threshold, timed_learn, train_sb3
+from .training import EvalCallback, median_steps, steps_to_threshold, timed_learn, train_sb3
 from .zoo_hyperparams import ZOO_DQN
 
 # Tuned DQN: rl-zoo3's settings for each env (benchmarks/zoo_hyperparams.py; policy
@@ -180,19 +180,20 @@ def run_peer(seed, samples):
 
 def summarise(runs):
     """Per env and agent: mean and sd of the final mean return over seeds, the steps to the
-    threshold (median of the seeds that reached it) and how many did, training seconds."""
+    threshold (`training.median_steps`: a seed that never reached it counts as the last)
+    and how many did, training seconds."""
     table = {}
     for run_ in runs:
         table.setdefault((run_["env"], run_["agent"]), []).append(run_)
     summary = []
     for (env_id, agent_name), group in table.items():
         finals = [r["final_mean"] for r in group]
-        solved = [r["steps_to_threshold"] for r in group if r["steps_to_threshold"] is not None]
+        crossings = [r["steps_to_threshold"] for r in group]
         summary.append({
             "env": env_id, "agent": agent_name, "seeds": [r["seed"] for r in group],
             "final_mean": float(np.mean(finals)), "final_sd": float(np.std(finals)),
-            "solved_runs": len(solved),
-            "median_steps_to_threshold": float(np.median(solved)) if solved else None,
+            "solved_runs": sum(c is not None for c in crossings),
+            "median_steps_to_threshold": median_steps(crossings),
             "train_seconds": float(np.mean([r["train_seconds"] for r in group])),
             "train_cpu_seconds": float(np.mean([r["train_cpu_seconds"] for r in group])),
         })

@@ -25,7 +25,7 @@ from stable_baselines3.common.vec_env import VecNormalize
 from fqi import evaluate
 
 __all__ = ["ALGORITHMS", "train_sb3", "timed_learn", "EvalCallback", "StopAt",
-           "steps_to_threshold", "WrappedPolicy", "torch_threads"]
+           "steps_to_threshold", "median_steps", "WrappedPolicy", "torch_threads"]
 
 ALGORITHMS = {"DQN": DQN, "PPO": PPO}
 
@@ -142,6 +142,20 @@ def steps_to_threshold(evaluations, threshold):
     if threshold is None:
         return None
     return next((steps for steps, score in evaluations if score >= threshold), None)
+
+
+def median_steps(crossings):
+    """The median of runs' `steps_to_threshold` values, a run that never reached the
+    threshold (None) counting as later than every other: None when that median run (or
+    either of the middle two) never reached it, or without runs.
+
+    >>> median_steps([15004, None, 25015, None, 20010])
+    25015.0
+    >>> median_steps([None, 20000, None]) is None
+    True
+    """
+    median = np.median([np.inf if c is None else c for c in crossings]) if crossings else None
+    return None if median is None or median == np.inf else float(median)
 
 
 def timed_learn(model, callback=None, **learn_kwargs):

@@ -22,7 +22,7 @@ MODULES = sorted(
     info.name
     for package in (boxtrees, fqi, envs)
     for info in pkgutil.iter_modules(package.__path__, package.__name__ + ".")
-) + ["boxtrees", "fqi", "envs"]
+) + ["boxtrees", "fqi", "envs", "benchmarks.training"]
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"

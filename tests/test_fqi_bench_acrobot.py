@@ -2,10 +2,8 @@
 DQN figures it reads beside them."""
 import json
 
-import numpy as np
-
 from benchmarks import bench_acrobot
-from benchmarks.training import steps_to_threshold
+from benchmarks.training import median_steps, steps_to_threshold
 
 
 def test_first_crossing_and_median_count_a_run_that_never_crosses_as_last():
@@ -13,8 +11,11 @@ def test_first_crossing_and_median_count_a_run_that_never_crosses_as_last():
     assert steps_to_threshold(curve, -100.0) == 10000
     assert steps_to_threshold(curve[:1], -100.0) is None
     assert steps_to_threshold(curve, None) is None
-    assert bench_acrobot._median([15004, None, 25015, None, 20010]) == 25015
-    assert bench_acrobot._median([None, None, 5000]) == np.inf
+    assert median_steps([15004, None, 25015, None, 20010]) == 25015
+    assert median_steps([None, None, 5000]) is None and median_steps([]) is None
+    # an even count: the mean of the middle two, never reached if either is
+    assert median_steps([10000, 20000, 30000, None]) == 25000
+    assert median_steps([10000, 20000, None, None]) is None
 
 
 def test_a_tiny_run_writes_its_curve_beside_the_cached_dqn_runs(tmp_path):

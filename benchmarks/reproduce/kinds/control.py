@@ -136,16 +136,19 @@ class Control(UnitKind):
                                   threshold=thresholds.pop() if len(thresholds) == 1 else None)
 
     def table(self, experiment, stats, runs):
+        from ...training import median_steps  # imports torch
+
         lines = ["| setting | runs | final mean return +- sd over runs | runs solved | median "
-                 "steps to the threshold | training minutes per run (CPU) |",
+                 "steps to the threshold (a run that never reached it counts as the last) | "
+                 "training minutes per run (CPU) |",
                  "| --- | --- | --- | --- | --- | --- |"]
         for label, s in stats.items():
             results = [r["result"] for r in runs[label]]
-            solved = [r["steps_to_threshold"] for r in results
-                      if r.get("steps_to_threshold") is not None]
+            crossings = [r.get("steps_to_threshold") for r in results]
+            median = median_steps(crossings)
             lines.append(f"| {label} | {s.n_runs} | {s.score:,.1f} +- {s.score_sd:,.1f} | "
-                         f"{len(solved)}/{s.n_runs} | "
-                         f"{fmt(float(np.median(solved))) if solved else '-'} | "
+                         f"{sum(c is not None for c in crossings)}/{s.n_runs} | "
+                         f"{'never' if median is None else fmt(median)} | "
                          f"{training_minutes(results)} |")
         return lines
 
