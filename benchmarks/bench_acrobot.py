@@ -1,9 +1,11 @@
 """Acrobot-v1: exploratory FQI settings against the tuned DQN, in environment steps to -100.
 
-FQI with grown-out Extra-Trees on the registry's leaf-backup setting (20 `leaf_backups`, 4
-envs), random actions held for zeta(3)-distributed durations, and one forest over the
-observation and the action (``action_input``) or one per action (``--per-action``), learns
-on the schedule of a 100,000-step run and stops at ``--stop`` steps. Every 5,000 steps its
+Variations of the registry's ``control_acrobot`` setting with one forest over observation
+and action (whose runs ``run_all --only control_acrobot`` makes, stopped at 50,000 steps):
+its FQI arguments (20 `leaf_backups`, 4 envs, random actions held for zeta(3)-distributed
+durations, ``action_input``) with ``--trees`` grown-out Extra-Trees, or one forest per
+action (``--per-action``), learn on the schedule of DQN's 100,000 steps and stop at
+``--stop`` steps. Every 5,000 steps its
 greedy policy plays 20 held-out episodes, as the registry's ``control`` kind scores its runs
 (`benchmarks.training.EvalCallback` on a synchronous vector env, `fqi.evaluate`'s default
 seeds). Printed and written per seed: the curve and the first evaluation at or above -100;
@@ -26,16 +28,20 @@ from sklearn.ensemble import ExtraTreesRegressor
 
 from fqi import FQI
 
-from .training import EvalCallback, StopAt, median_steps, steps_to_threshold, timed_learn
+from .reproduce.registry import ACTION_INPUT_LABEL, REGISTRY
+from .reproduce.stats import median_steps, steps_to_threshold
+from .training import EvalCallback, StopAt, timed_learn
 
-ENV, THRESHOLD, BUDGET, EVAL_EVERY, EVAL_EPISODES = "Acrobot-v1", -100.0, 100_000, 5000, 20
+SETTING = REGISTRY["control_acrobot"].params(ACTION_INPUT_LABEL)
+ENV, THRESHOLD, BUDGET = SETTING["env_id"], SETTING["threshold"], SETTING["steps"]
+EVAL_EVERY, EVAL_EPISODES = 5000, 20  # the control kind's
 DQN_RUNS = Path("runs/full/control_acrobot/DQN_rl-zoo3")  # under --results
 
 
 def run_seed(seed, n_trees, stop, action_input):
     """One FQI run; its curve, first crossing and training seconds."""
-    agent = FQI(ExtraTreesRegressor(n_estimators=n_trees), ENV, action_input=action_input,
-                leaf_backups=20, n_envs=4, exploration_zeta=3, eval_episodes=0, seed=seed)
+    agent = FQI(ExtraTreesRegressor(n_estimators=n_trees), ENV,
+                **{**SETTING["fqi"], "action_input": action_input}, eval_episodes=0, seed=seed)
     evaluation = gym.make_vec(ENV, EVAL_EPISODES, vectorization_mode="sync")
     curve = EvalCallback(evaluation, EVAL_EVERY, n_episodes=EVAL_EPISODES)
     seconds, _ = timed_learn(agent, [curve, StopAt(stop)], total_timesteps=BUDGET)

@@ -47,7 +47,8 @@ from tqdm.auto import tqdm
 
 from fqi import FQI, evaluate, make_box_forest
 
-from .training import EvalCallback, median_steps, steps_to_threshold, timed_learn, train_sb3
+from .reproduce.stats import median_steps, steps_to_threshold
+from .training import EvalCallback, timed_learn, train_sb3
 from .zoo_hyperparams import ZOO_DQN
 
 # Tuned DQN: rl-zoo3's settings for each env (benchmarks/zoo_hyperparams.py; policy

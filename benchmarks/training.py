@@ -4,7 +4,8 @@
   with one torch thread and no log folder;
 - `EvalCallback`: scores the model on fixed reset seeds (`fqi.evaluate`) every
   ``eval_freq`` environment steps and when training ends, for SB3 models and `fqi.FQI`
-  alike, and times training without its evaluations;
+  alike, and times training without its evaluations (`timed_learn`);
+- `StopAt`: ends training after a number of environment steps;
 - `WrappedPolicy`: a model trained on an observation wrapper's output, playing from the
   env's own observations.
 
@@ -25,7 +26,7 @@ from stable_baselines3.common.vec_env import VecNormalize
 from fqi import evaluate
 
 __all__ = ["ALGORITHMS", "train_sb3", "timed_learn", "EvalCallback", "StopAt",
-           "steps_to_threshold", "median_steps", "WrappedPolicy", "torch_threads"]
+           "WrappedPolicy", "torch_threads"]
 
 ALGORITHMS = {"DQN": DQN, "PPO": PPO}
 
@@ -124,9 +125,16 @@ class EvalCallback(BaseCallback):
 
 
 class StopAt(BaseCallback):
-    """Ends ``learn`` once the model has taken `steps` environment steps: a run on the
-    schedule of a longer ``total_timesteps`` (its exploration decays as in that run), cut
-    short. Put it after an `EvalCallback` in the list, so that the last step is scored."""
+    """Ends ``learn`` once the model has taken `steps` environment steps (counting every
+    ``learn`` call's): a run on the schedule of a longer ``total_timesteps`` (its
+    exploration decays as in that run), cut short.
+
+    An SB3 model stops after the vector step that reaches `steps` (fewer than ``n_envs``
+    steps past it); `fqi.FQI` calls its callbacks after each iteration, so it stops after
+    the first iteration whose collection reaches `steps` (its round's end, up to
+    ``n_envs - 1`` steps more), skipping that round's remaining backups. An `EvalCallback`
+    beside it scores the last step either way (at training's end).
+    """
 
     def __init__(self, steps):
         super().__init__()
@@ -134,28 +142,6 @@ class StopAt(BaseCallback):
 
     def _on_step(self):
         return self.num_timesteps < self.steps
-
-
-def steps_to_threshold(evaluations, threshold):
-    """The steps of the first ``[steps, score]`` of `evaluations` (an `EvalCallback`'s)
-    scoring at least `threshold`; None if none does, or if `threshold` is None."""
-    if threshold is None:
-        return None
-    return next((steps for steps, score in evaluations if score >= threshold), None)
-
-
-def median_steps(crossings):
-    """The median of runs' `steps_to_threshold` values, a run that never reached the
-    threshold (None) counting as later than every other: None when that median run (or
-    either of the middle two) never reached it, or without runs.
-
-    >>> median_steps([15004, None, 25015, None, 20010])
-    25015.0
-    >>> median_steps([None, 20000, None]) is None
-    True
-    """
-    median = np.median([np.inf if c is None else c for c in crossings]) if crossings else None
-    return None if median is None or median == np.inf else float(median)
 
 
 def timed_learn(model, callback=None, **learn_kwargs):
@@ -199,7 +185,7 @@ def train_sb3(algo, make_env, total_timesteps, hyperparams, *, seed=None, callba
         observations hold padding rows and a presence mask) are taken out.
     seed : int, default=None
         Seeds the algorithm and the training envs.
-    callback : BaseCallback, default=None
+    callback : BaseCallback or list of them, default=None
         An `EvalCallback` is timed apart from training.
     policy : str, default="MlpPolicy"
 

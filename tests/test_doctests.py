@@ -1,8 +1,8 @@
-"""Every docstring example of the packages runs (each module of boxtrees, fqi and envs), and so
-does every ```python block of README.md and docs/*.md: a block of ">>>" examples as a
-doctest (README.md's in tests/test_fqi_readme.py), any other as a script. A block that
-cannot run in the tests (a long training run) has a marker on the line above its fence,
-``<!-- skip-test: why -->``; it is still compiled."""
+"""Every docstring example of the packages runs (each module of boxtrees, fqi and envs, and the
+benchmarks' run statistics), and so does every ```python block of README.md and docs/*.md: a
+block of ">>>" examples as a doctest (README.md's in tests/test_fqi_readme.py), any other as
+a script. A block that cannot run in the tests (a long training run) has a marker on the
+line above its fence, ``<!-- skip-test: why -->``; it is still compiled."""
 import doctest
 import importlib
 import json
@@ -22,7 +22,7 @@ MODULES = sorted(
     info.name
     for package in (boxtrees, fqi, envs)
     for info in pkgutil.iter_modules(package.__path__, package.__name__ + ".")
-) + ["boxtrees", "fqi", "envs", "benchmarks.training"]
+) + ["boxtrees", "fqi", "envs", "benchmarks.reproduce.stats"]
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"

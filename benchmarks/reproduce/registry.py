@@ -604,7 +604,7 @@ _HELD_ENVS = ("MountainCar-v0",)
 # run follows the schedule of DQN's 100,000 steps and stops at half of them (a 150-tree run
 # costs about 10 times the 30-tree runs' per step and grows with the kept data)
 _ACTION_INPUT = {**_LEAF_BACKUPS, "exploration_zeta": 3, "action_input": True}
-_ACTION_INPUT_LABEL = ("FQI, 150 Extra-Trees grown out, action input, 20 leaf backups, "
+ACTION_INPUT_LABEL = ("FQI, 150 Extra-Trees grown out, action input, 20 leaf backups, "
                        "4 envs, zeta 3, stopped at half")
 _ACTION_INPUT_ENVS = ("Acrobot-v1",)
 _CONTROL_FQI = {"FQI, Extra-Trees": "extra-trees",
@@ -634,7 +634,7 @@ def _control(env_id):
                                   "fqi": _LEAF_BACKUPS},
             **({_HELD_LABEL: {**fqi, "regressor": "extra-trees, grown out", "fqi": _HELD}}
                if env_id in _HELD_ENVS else {}),
-            **({_ACTION_INPUT_LABEL: {**fqi, "regressor": "extra-trees, 150 grown out",
+            **({ACTION_INPUT_LABEL: {**fqi, "regressor": "extra-trees, 150 grown out",
                                       "fqi": _ACTION_INPUT, "stop": steps // 2}}
                if env_id in _ACTION_INPUT_ENVS else {}),
             "DQN (rl-zoo3)": {"learner": "DQN", "hyperparams": ZOO_DQN[env_id],

@@ -4,7 +4,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["SettingStats", "LAST_WINDOW", "last_window", "sd", "se"]
+__all__ = ["SettingStats", "LAST_WINDOW", "last_window", "sd", "se", "steps_to_threshold",
+           "median_steps"]
 
 # A run's score: its mean reward over the last iterations (the thesis's "converges to").
 LAST_WINDOW = 5
@@ -82,3 +83,25 @@ def se(values):
     """Standard error of the mean of every value of `values` (NaN for a single value)."""
     values = np.ravel(values)
     return float(np.std(values, ddof=1) / np.sqrt(len(values))) if len(values) > 1 else np.nan
+
+
+def steps_to_threshold(evaluations, threshold):
+    """The steps of the first ``[steps, score]`` of `evaluations` (an `EvalCallback`'s)
+    scoring at least `threshold`; None if none does, or if `threshold` is None."""
+    if threshold is None:
+        return None
+    return next((steps for steps, score in evaluations if score >= threshold), None)
+
+
+def median_steps(crossings):
+    """The median of runs' `steps_to_threshold` values, a run that never reached the
+    threshold (None) counting as later than every other: None when that median run (or
+    either of the middle two) never reached it, or without runs.
+
+    >>> median_steps([15004, None, 25015, None, 20010])
+    25015.0
+    >>> median_steps([None, 20000, None]) is None
+    True
+    """
+    median = np.median([np.inf if c is None else c for c in crossings]) if crossings else None
+    return None if median is None or median == np.inf else float(median)

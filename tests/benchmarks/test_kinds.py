@@ -151,6 +151,10 @@ def test_reference_policies_score_on_the_reference_worlds_as_learners_do():
      r"stop must be None or a whole number from 1 to steps \(10\), got 11"),
     ("control", {"env_id": "CartPole-v1", "learner": "DQN", "steps": 10, "stop": 0.5},
      "stop must be None or a whole number"),
+    ("control", {"env_id": "CartPole-v1", "learner": "DQN", "steps": 10, "stop": 0},
+     "stop must be None or a whole number from 1"),
+    ("control", {"env_id": "CartPole-v1", "learner": "fqi", "steps": 10, "stop": True},
+     "stop must be None or a whole number"),
 ])
 def test_a_settings_mistake_is_named(kind, params, match):
     with pytest.raises(ValueError, match=match):
@@ -194,14 +198,17 @@ def test_a_kind_is_one_class_that_registers_itself(tmp_path):
 
 
 def test_a_stopped_control_run_ends_at_its_stop_on_the_schedule_of_its_steps(tmp_path):
-    """``stop`` cuts the run short after the round that reaches it; epsilon still decays over
-    ``steps``, so a stopped run is the start of the full one."""
+    """``stop`` cuts the run short after the iteration whose collection reaches it (an SB3
+    model: after the step); epsilon still decays over ``steps``, so a stopped FQI run is the
+    start of the full one."""
     fqi = {"samples_per_iteration": 100, "n_envs": 1, "resample_every": 1,
            "exploration_fraction": 1.0, "exploration_final_eps": 0.0}
     common = {"env_id": "CartPole-v1", "learner": "fqi", "steps": 1000,
               "regressor": "extra-trees", "fqi": fqi, "eval_every": 100, "eval_episodes": 2}
     experiment = Experiment("stopped", "extra", "Stopped", "control", on_demand=True,
-                            settings={"full": common, "stopped": {**common, "stop": 300}})
+                            settings={"full": common, "stopped": {**common, "stop": 300},
+                                      "DQN stopped": {**common, "learner": "DQN", "stop": 300,
+                                                      "hyperparams": {"learning_starts": 100}}})
     full_budget = replace(TINY, control_scale=1.0)
     results = {}
     for label in experiment.settings:
@@ -211,6 +218,30 @@ def test_a_stopped_control_run_ends_at_its_stop_on_the_schedule_of_its_steps(tmp
     assert stopped["total_timesteps"] == 300 and full["total_timesteps"] == 1000
     assert [steps for steps, _ in stopped["curve"]] == [100, 200, 300]
     assert stopped["curve"] == full["curve"][:3]
+    dqn = results["DQN stopped"]
+    assert dqn["total_timesteps"] == 300 and [s for s, _ in dqn["curve"]] == [100, 200, 300]
+
+
+def test_the_control_table_counts_a_run_that_never_reached_the_threshold_as_the_last():
+    """The median of 5 runs, 2 never past: the third of the others; of 3, 2 never: never;
+    without a threshold, no count and no median."""
+    control = KINDS["control"]
+    settings = {label: {"env_id": "CartPole-v1", "learner": "fqi", "steps": 10,
+                        "threshold": threshold}
+                for label, threshold in (("five", 475.0), ("three", 475.0), ("none", None))}
+    experiment = Experiment("table", "extra", "Table", "control", on_demand=True,
+                            settings=settings)
+    crossings = {"five": [10, None, 30, None, 20], "three": [10, None, None],
+                 "none": [None, None]}
+    runs = {label: [{"result": {"steps_to_threshold": c, "reward": 1.0, "seconds": 60.0,
+                                "train_seconds": 60.0,
+                                "train_cpu_seconds": 60.0}} for c in values]
+            for label, values in crossings.items()}
+    stats = {label: control.summarise(label, [r["result"] for r in runs[label]])
+             for label in runs}
+    rows = {line.split(" | ")[0].lstrip("| "): line.split(" | ")[3:5]
+            for line in control.table(experiment, stats, runs)[2:]}
+    assert rows == {"five": ["3/5", "30"], "three": ["1/3", "never"], "none": ["-", "-"]}
 
 
 def test_gymnasium_tasks_run_each_learner_and_report_its_steps_to_the_threshold(tmp_path):

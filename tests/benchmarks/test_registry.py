@@ -159,7 +159,7 @@ def test_the_control_runs_measured_fqis_current_defaults():
 @pytest.mark.parametrize("name, first_ties, held, action_input", [
     ("control_cartpole", True, False, False), ("control_acrobot", True, False, True),
     ("control_mountaincar", False, True, False), ("control_lunarlander", False, False, False)])
-def test_first_action_tie_runs_only_where_they_were_made(name, first_ties, held, action_input):
+def test_the_control_settings_per_env(name, first_ties, held, action_input):
     """The envs run before `tie_break` existed keep those runs beside the new default's; the
     others run each FQI setting once, with ties broken at random; MountainCar alone adds a
     setting with held random actions, Acrobot one forest over observation and action that
@@ -176,6 +176,8 @@ def test_first_action_tie_runs_only_where_they_were_made(name, first_ties, held,
     for label in stopped:
         params = REGISTRY[name].params(label)
         assert params["fqi"]["action_input"] and params["stop"] * 2 == params["steps"]
+        assert params["fqi"]["exploration_zeta"] == 3
+        assert params["regressor"] == "extra-trees, 150 grown out"
     assert sum(label.startswith("FQI") for label in labels) == (4 + 3 * first_ties + held
                                                                 + action_input)
     assert {"DQN (rl-zoo3)", "PPO (rl-zoo3)"} <= set(labels)

@@ -12,6 +12,7 @@ from fqi import FQI, make_box_forest
 
 from .. import plots
 from ..cache import ListOf
+from ..stats import median_steps, steps_to_threshold
 from ._base import UnitKind, fmt
 
 __all__ = ["Control", "REGRESSORS", "training_minutes"]
@@ -27,7 +28,7 @@ REGRESSORS = {
     "box-classic": lambda: make_box_forest(test_type="classic", n_estimators=30, n_tests=10,
                                            min_samples_split=10, n_jobs=1),
 }
-_SECONDS_PER_STEP = 2.5e-3  # FQI's defaults on CartPole-v1, one core (measured)
+_SECONDS_PER_STEP = 2.5e-3  # FQI's defaults on CartPole-v1 (30 trees), one core (measured)
 # FQI's arguments a setting may give (the kind sets the others)
 _FQI_SETTABLE = frozenset(inspect.signature(FQI).parameters) - {
     "regressor", "env", "eval_episodes", "seed"}
@@ -63,6 +64,7 @@ class ControlSettings:
         if not isinstance(self.steps, int) or self.steps < 1:
             raise ValueError(f"steps must be a whole number >= 1, got {self.steps!r}")
         if self.stop is not None and not (isinstance(self.stop, int)
+                                          and not isinstance(self.stop, bool)
                                           and 1 <= self.stop <= self.steps):
             raise ValueError(f"stop must be None or a whole number from 1 to steps "
                              f"({self.steps}), got {self.stop!r}")
@@ -82,8 +84,7 @@ class Control(UnitKind):
     budget_fields = ("control_scale",)
 
     def run(self, unit, checkpoint=None):
-        from ...training import (  # imports torch
-            EvalCallback, StopAt, steps_to_threshold, timed_learn, train_sb3)
+        from ...training import EvalCallback, StopAt, timed_learn, train_sb3  # imports torch
 
         settings, scale = unit.settings, unit.budget.control_scale
         steps = max(1, round(settings.steps * scale))
@@ -109,14 +110,18 @@ class Control(UnitKind):
             evaluation.close()
         return {"reward": curve.evaluations[-1][1], "curve": curve.evaluations,
                 "steps_to_threshold": steps_to_threshold(curve.evaluations,
-                                                         settings.threshold), "total_timesteps": int(done),
+                                                         settings.threshold),
+                "total_timesteps": int(done),
                 "train_seconds": seconds, "train_cpu_seconds": cpu_seconds,
                 "eval_seconds": curve.eval_seconds}
 
     def cost(self, unit):
         settings = unit.settings
         steps = settings.steps if settings.stop is None else settings.stop
-        return _SECONDS_PER_STEP * steps * unit.budget.control_scale
+        seconds = _SECONDS_PER_STEP * steps * unit.budget.control_scale
+        if settings.learner == "fqi":  # measured with 30 trees: the fits scale with them
+            seconds *= REGRESSORS[settings.regressor]().n_estimators / 30
+        return seconds
 
     def record_shape(self, budget):
         return {"reward": float, "curve": ListOf(ListOf(float, 2))}
@@ -136,8 +141,6 @@ class Control(UnitKind):
                                   threshold=thresholds.pop() if len(thresholds) == 1 else None)
 
     def table(self, experiment, stats, runs):
-        from ...training import median_steps  # imports torch
-
         lines = ["| setting | runs | final mean return +- sd over runs | runs solved | median "
                  "steps to the threshold (a run that never reached it counts as the last) | "
                  "training minutes per run (CPU) |",
@@ -146,10 +149,13 @@ class Control(UnitKind):
             results = [r["result"] for r in runs[label]]
             crossings = [r.get("steps_to_threshold") for r in results]
             median = median_steps(crossings)
+            if experiment.params(label).get("threshold") is None:
+                solved = steps = "-"
+            else:
+                solved = f"{sum(c is not None for c in crossings)}/{s.n_runs}"
+                steps = "never" if median is None else fmt(median)
             lines.append(f"| {label} | {s.n_runs} | {s.score:,.1f} +- {s.score_sd:,.1f} | "
-                         f"{sum(c is not None for c in crossings)}/{s.n_runs} | "
-                         f"{'never' if median is None else fmt(median)} | "
-                         f"{training_minutes(results)} |")
+                         f"{solved} | {steps} | {training_minutes(results)} |")
         return lines
 
 
