@@ -24,6 +24,8 @@ _STANDARD = {"model": "box", "test_type": "fixed", "test_width": 1.0, "n_estimat
              "n_tests": 300, "min_samples_split": 30}
 # Thesis 3.2 on: the tuned K = 500, M = 30, n_min = 30.
 _TUNED = {**_STANDARD, "n_estimators": 30, "n_tests": 500}
+# Beyond the thesis: the tuned settings on kept data, the latest 100,000 transitions
+_KEPT_DATA = {**_TUNED, "keep_data": True, "max_samples": 100_000}
 _REPRESENTATIONS = {
     "fixed TW=1": {"test_type": "fixed", "test_width": 1.0},
     "bounded TW=4": {"test_type": "bounded", "test_width": 4.0},
@@ -229,7 +231,7 @@ EXPERIMENTS = (
     # ---------------------------------------------------------------- beyond the thesis
     Experiment(
         "keep_data", "extra", "Keeping earlier data (thesis future work) vs normal and mixed",
-        "fqi", defaults={**_TUNED, "keep_data": True, "max_samples": 100_000},
+        "fqi", defaults=_KEPT_DATA,
         settings={"keep data (100k)": {}, "normal": {"same_as": "sampling/normal"},
                   "mixed (every 5)": {"same_as": "sampling/mixed (every 5)"}},
         thesis={"keep data (100k)": "hypothesis: stable and high (future work)"},
@@ -240,7 +242,7 @@ EXPERIMENTS = (
         notes="The data set keeps the most recent 100,000 transitions (5 iterations)."),
     Experiment(
         "keep_data_horizon", "extra", "Keeping data with a longer horizon or more data",
-        "fqi", on_demand=True, defaults={**_TUNED, "keep_data": True, "max_samples": 100_000},
+        "fqi", on_demand=True, defaults=_KEPT_DATA,
         settings={"gamma 0.5, 100k": {"same_as": "keep_data/keep data (100k)"},
                   "gamma 0.8, 100k": {"gamma": 0.8},
                   "gamma 0.5, 200k": {"max_samples": 200_000},
@@ -251,7 +253,7 @@ EXPERIMENTS = (
               "(the latest 200,000 transitions, 10 iterations)."),
     Experiment(
         "keep_data_boxes", "extra", "Keeping data with bounded boxes", "fqi",
-        on_demand=True, defaults={**_TUNED, "keep_data": True, "max_samples": 100_000},
+        on_demand=True, defaults=_KEPT_DATA,
         settings={"fixed TW=1": {"same_as": "keep_data/keep data (100k)"},
                   "bounded TW=2.5": {"test_type": "bounded", "test_width": 2.5}},
         notes="Bounded boxes of half-width up to 2.5 peaked highest in Fig. 3.4 (best "
@@ -261,7 +263,7 @@ EXPERIMENTS = (
               "fixed boxes (about 200,000)."),
     Experiment(
         "keep_data_tests", "extra", "Keeping data with more tests per node", "fqi",
-        on_demand=True, defaults={**_TUNED, "keep_data": True, "max_samples": 100_000},
+        on_demand=True, defaults=_KEPT_DATA,
         settings={"K=500": {"same_as": "keep_data/keep data (100k)"},
                   "K=1000": {"n_tests": 1000}},
         notes="More tests per node scored higher at every step of Fig. A.1/3.2 (K=300: "
