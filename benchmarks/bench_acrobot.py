@@ -28,22 +28,25 @@ from sklearn.ensemble import ExtraTreesRegressor
 
 from fqi import FQI
 
+from .reproduce.budgets import BUDGETS
+from .reproduce.cache import unit_path
+from .reproduce.kinds import KINDS
 from .reproduce.registry import ACTION_INPUT_LABEL, REGISTRY
 from .reproduce.stats import median_steps, steps_to_threshold
 from .training import EvalCallback, StopAt, timed_learn
 
-SETTING = REGISTRY["control_acrobot"].params(ACTION_INPUT_LABEL)
-ENV, THRESHOLD, BUDGET = SETTING["env_id"], SETTING["threshold"], SETTING["steps"]
-EVAL_EVERY, EVAL_EPISODES = 5000, 20  # the control kind's
-DQN_RUNS = Path("runs/full/control_acrobot/DQN_rl-zoo3")  # under --results
+SETTING = KINDS["control"].settings(REGISTRY["control_acrobot"].params(ACTION_INPUT_LABEL))
+ENV, THRESHOLD, BUDGET = SETTING.env_id, SETTING.threshold, SETTING.steps
+# the registry's tuned-DQN runs, under --results
+DQN_RUNS = unit_path("", BUDGETS["full"], "control_acrobot", "DQN (rl-zoo3)", 0).parent
 
 
 def run_seed(seed, n_trees, stop, action_input):
     """One FQI run; its curve, first crossing and training seconds."""
     agent = FQI(ExtraTreesRegressor(n_estimators=n_trees), ENV,
-                **{**SETTING["fqi"], "action_input": action_input}, eval_episodes=0, seed=seed)
-    evaluation = gym.make_vec(ENV, EVAL_EPISODES, vectorization_mode="sync")
-    curve = EvalCallback(evaluation, EVAL_EVERY, n_episodes=EVAL_EPISODES)
+                **{**SETTING.fqi, "action_input": action_input}, eval_episodes=0, seed=seed)
+    evaluation = gym.make_vec(ENV, SETTING.eval_episodes, vectorization_mode="sync")
+    curve = EvalCallback(evaluation, SETTING.eval_every, n_episodes=SETTING.eval_episodes)
     seconds, _ = timed_learn(agent, [curve, StopAt(stop)], total_timesteps=BUDGET)
     evaluation.close()
     return {"seed": seed, "curve": curve.evaluations,
@@ -69,7 +72,8 @@ def plot(runs, path):
         steps, values = zip(*run["curve"])
         ax.plot(steps, values, marker="o", label=f"seed {run['seed']}")
     ax.axhline(THRESHOLD, color="k", ls="--", lw=1, label="threshold")
-    ax.set(xlabel="environment steps", ylabel="mean return (20 held-out episodes)",
+    ax.set(xlabel="environment steps",
+           ylabel=f"mean return ({SETTING.eval_episodes} held-out episodes)",
            title=f"FQI on {ENV}", ylim=(-510, -50))
     ax.legend(fontsize=8)
     fig.tight_layout()
