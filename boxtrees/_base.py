@@ -9,7 +9,6 @@ from math import ceil
 from numbers import Integral, Real
 
 import numpy as np
-from joblib import effective_n_jobs
 from scipy.sparse import csr_matrix
 from sklearn.base import BaseEstimator, ClassifierMixin, RegressorMixin
 from sklearn.utils._param_validation import Interval, RealNotInt, StrOptions
@@ -24,7 +23,7 @@ from ._objects import (_FLOAT32_MAX, ObjectInputMixin, check_view_bounds, column
 from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
 from ._splitter import TEST_KINDS
-from ._threads import thread_pool
+from ._threads import thread_pool, threads_for
 from ._typing import SetsOrMatrix
 
 # prediction splits a batch into chunks of at least this many samples, one per thread
@@ -124,7 +123,8 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
 
     def _traverse(self, X, kernel, out, n_jobs=None):
         """Validate ``X`` and run a traversal kernel over its samples into ``out(n)``, split
-        over up to ``n_jobs`` threads in chunks of at least `_PREDICT_CHUNK_MIN` samples."""
+        over up to ``threads_for(n_jobs)`` threads, the calling one among them, in chunks of
+        at least `_PREDICT_CHUNK_MIN` samples."""
         if "_packed" not in self.__dict__:  # cheap test first: predict is called per step
             check_is_fitted(self)
         sets, _ = self._validate_input(X, reset=False)
@@ -132,17 +132,20 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         out = out(n)
         packed = self._packed  # one forest for every chunk, even if another thread refits
         n_chunks = n // _PREDICT_CHUNK_MIN
-        if n_chunks > 1:  # effective_n_jobs costs as much as predicting one sample
-            n_threads = effective_n_jobs(n_jobs)
-            n_chunks = min(n_threads, n_chunks)
+        if n_chunks > 1:  # threads_for costs as much as predicting one sample
+            n_chunks = min(threads_for(n_jobs), n_chunks)
         if n_chunks <= 1:
             results = [kernel(packed, sets.data, sets.offsets, out)]
         else:
             edges = np.linspace(0, n, n_chunks + 1).astype(np.intp)
-            results = list(thread_pool(n_threads).map(
-                lambda a, b: kernel(packed, sets.data, sets.offsets[a : b + 1], out[a:b]),
-                edges[:-1], edges[1:],
-            ))
+
+            def chunk(a, b):
+                return kernel(packed, sets.data, sets.offsets[a : b + 1], out[a:b])
+
+            # the first chunk in this thread, which would otherwise only wait
+            others = [thread_pool(n_chunks - 1).submit(chunk, a, b)
+                      for a, b in zip(edges[1:-1], edges[2:])]
+            results = [chunk(edges[0], edges[1]), *(future.result() for future in others)]
         for problem, row in results:
             if problem == RowProblem.BAD_OFFSETS:
                 raise ValueError("the offsets of X changed while it was being read")

@@ -1,14 +1,19 @@
 """Long-lived thread pools, one per purpose and size, started on first use and forgotten in
-a forked child (whose parent's threads are gone)."""
+a forked child (whose parent's threads are gone), and the share of the cores a call made
+from one of their threads may use."""
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
-__all__ = ["thread_pool"]
+from joblib import effective_n_jobs
+
+__all__ = ["thread_pool", "threads_for"]
 
 # (purpose, threads) -> the pool of this process
 _POOLS: dict[tuple[str, int], ThreadPoolExecutor] = {}
 _POOLS_LOCK = threading.Lock()
+# in a pool's thread: `siblings`, the number of threads of that pool
+_LOCAL = threading.local()
 
 
 def _forget_pools_after_fork():
@@ -22,6 +27,10 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_forget_pools_after_fork)
 
 
+def _join_pool(n_threads):
+    _LOCAL.siblings = n_threads
+
+
 def thread_pool(n_threads: int, purpose: str = "boxtrees-predict") -> ThreadPoolExecutor:
     """The process's pool of `n_threads` threads for `purpose`, started on first use.
 
@@ -29,7 +38,8 @@ def thread_pool(n_threads: int, purpose: str = "boxtrees-predict") -> ThreadPool
     where starting threads (as a joblib ``Parallel`` call does) costs about as much as the
     work; the kernels release the GIL, so long-lived threads share a batch at no such cost.
     Pools of different purposes are distinct, so that work in one pool may wait on work in
-    another (an agent's per-action predictions on a forest's own) without deadlock.
+    another (an agent's per-action predictions on a forest's own) without deadlock; work
+    submitted from a pool's thread should take its share of the cores (`threads_for`).
 
     Parameters
     ----------
@@ -44,5 +54,34 @@ def thread_pool(n_threads: int, purpose: str = "boxtrees-predict") -> ThreadPool
     key = (purpose, n_threads)
     with _POOLS_LOCK:
         if key not in _POOLS:
-            _POOLS[key] = ThreadPoolExecutor(n_threads, thread_name_prefix=purpose)
+            _POOLS[key] = ThreadPoolExecutor(n_threads, thread_name_prefix=purpose,
+                                             initializer=_join_pool, initargs=(n_threads,))
         return _POOLS[key]
+
+
+def threads_for(n_jobs: int | None) -> int:
+    """The threads a call with `n_jobs` may use: joblib's ``effective_n_jobs(n_jobs)``,
+    divided among the threads of the pool the calling thread belongs to, if any (at least 1).
+
+    A pool's threads already keep that many cores busy: a forest predicting in each of the 2
+    threads of an agent's per-action pool, on 2 cores, predicts in its caller's thread
+    instead of adding 2 threads of its own (4 threads on 2 cores only add switching).
+
+    Parameters
+    ----------
+    n_jobs : int or None
+        As in joblib (-1: every core).
+
+    Returns
+    -------
+    n_threads : int
+
+    Examples
+    --------
+    >>> from boxtrees._threads import thread_pool, threads_for
+    >>> threads_for(1)
+    1
+    >>> thread_pool(4, "example").submit(threads_for, 8).result()
+    2
+    """
+    return max(effective_n_jobs(n_jobs) // getattr(_LOCAL, "siblings", 1), 1)

@@ -185,11 +185,11 @@ class FQI:
         spec; one without a spec needs `eval_env` or ``eval_episodes=0``).
     n_jobs : int, default=1
         Threads predicting the per-action Q-functions concurrently (at most one per
-        action; -1: one per core); 1 predicts them one after the other. Threads help only a
-        regressor that predicts on one core and releases the GIL: the box forests of
-        `fqi.make_box_forest` already use every core (measured: no gain), and
-        scikit-learn's forests, predicted from several threads at once, emit spurious
-        warnings about their configuration.
+        action; -1: one per core); 1 predicts them one after the other. Threads help a
+        regressor whose prediction releases the GIL. A box forest (`fqi.make_box_forest`)
+        predicting in one of them uses its share of the cores, not every core: on 2 cores,
+        the thesis's 4 forests of 30 trees predicted 400 game states at a time about 10%
+        faster with ``n_jobs=-1`` than with 1 (their own threads alone).
     log_path : str or path-like, default=None
         CSV file receiving one row per iteration (see `history` for the columns); its
         directory must exist and be writable (checked here, see `CSVLogger`).

@@ -2,10 +2,9 @@
 import warnings
 
 import numpy as np
-from joblib import effective_n_jobs
 from sklearn.base import clone
 
-from boxtrees._threads import thread_pool
+from boxtrees._threads import thread_pool, threads_for
 
 __all__ = []
 
@@ -91,9 +90,10 @@ class _QFunction:
 
     def values(self, batch, n_jobs=1):
         """``Q(s, a)`` of every action for the observations of `batch`, shape ``(n,
-        n_actions)``, predicted in up to `n_jobs` threads (one action each) and checked to be
-        one finite value per observation."""
-        n_threads = min(effective_n_jobs(n_jobs), len(self.models))
+        n_actions)``, predicted in up to `n_jobs` threads (one action each; a box forest
+        then predicts in its action's thread, see `boxtrees._threads.threads_for`) and
+        checked to be one finite value per observation."""
+        n_threads = min(threads_for(n_jobs), len(self.models))
         if n_threads == 1:
             predictions = [model.predict(batch) for model in self.models]
         else:

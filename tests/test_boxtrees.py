@@ -8,7 +8,9 @@ import pytest
 from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.metrics import r2_score
 
+import boxtrees._base
 from boxtrees import BoxExtraTreesRegressor, GridCounts, ObjectSets, make_box_regression
+from boxtrees._threads import thread_pool
 from conftest import THESIS_FOREST, run_in_fork
 
 
@@ -183,6 +185,22 @@ def test_parallel_predict_equals_serial_predict(n, n_jobs):
     forest.set_params(n_jobs=n_jobs)
     np.testing.assert_array_equal(forest.predict(X_new), serial)
     np.testing.assert_array_equal(forest.apply(X_new), leaves)
+
+
+def test_a_forest_in_a_pool_thread_predicts_on_its_share_of_the_cores(monkeypatch):
+    # in one of 2 threads of an agent's pool, n_jobs=2 is one thread: the caller's own
+    X, y = make_box_regression(500, random_state=0)
+    forest = thesis_forest(n_estimators=4, n_tests=20, n_jobs=2, random_state=0).fit(X, y)
+    expected = forest.predict(X)
+
+    def no_pool(*args):
+        raise AssertionError("predicted on threads of its own")
+
+    monkeypatch.setattr(boxtrees._base, "thread_pool", no_pool)
+    in_pool = thread_pool(2, "test-share").submit(forest.predict, X).result()
+    np.testing.assert_array_equal(in_pool, expected)
+    with pytest.raises(AssertionError, match="threads of its own"):
+        forest.predict(X)           # outside a pool: 2 threads, the caller and one more
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")

@@ -86,8 +86,9 @@ def _capped(value, cap):
 def make_agent(settings, budget, seed, samples):
     """The FQI agent of a registry setting on the game, with the thesis's protocol: up to
     400 training worlds in lockstep (the game's batched engine, through its vector entry
-    point), epsilon 0.2, greedy ties to the first action, evaluated on the reference worlds
-    after every iteration; learn it with ``learn(n_iterations=...)``.
+    point), epsilon 0.2, greedy ties to the first action, the actions' forests fitted and
+    predicted side by side on every core, evaluated on the reference worlds after every
+    iteration; learn it with ``learn(n_iterations=...)``.
 
     Parameters
     ----------
@@ -108,7 +109,7 @@ def make_agent(settings, budget, seed, samples):
                keep_data=settings.keep_data,
                max_samples=max(settings.max_samples or samples, samples),
                exploration_initial_eps=THESIS_EPSILON, exploration_final_eps=THESIS_EPSILON,
-               tie_break="first", n_envs=min(400, samples),
+               tie_break="first", n_envs=min(400, samples), n_jobs=-1,
                eval_seeds=reference_seeds(env, budget), seed=seed)
 
 
