@@ -635,7 +635,7 @@ def _control(env_id):
     first_ties = env_id in _CONTROL_FIRST_TIES
     return Experiment(
         f"control_{env_id.split('-')[0].lower()}", "extra",
-        f"{env_id}: FQI with its defaults against tuned DQN and PPO", "control",
+        f"{env_id}: FQI, with its defaults and tuned, against tuned DQN and PPO", "control",
         env_id=env_id, on_demand=True, defaults={"threshold": _CONTROL[env_id]},
         settings={
             **{label: {**fqi, "regressor": regressor}
