@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import inspect
 import warnings
+from concurrent.futures import wait
 from dataclasses import dataclass
 from math import ceil
 from numbers import Integral, Real
@@ -145,7 +146,11 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             # the first chunk in this thread, which would otherwise only wait
             others = [thread_pool(n_chunks - 1).submit(chunk, a, b)
                       for a, b in zip(edges[1:-1], edges[2:])]
-            results = [chunk(edges[0], edges[1]), *(future.result() for future in others)]
+            try:
+                results = [chunk(edges[0], edges[1])]
+            finally:
+                wait(others)    # no chunk outlives the call, even if this one failed
+            results += [future.result() for future in others]
         for problem, row in results:
             if problem == RowProblem.BAD_OFFSETS:
                 raise ValueError("the offsets of X changed while it was being read")

@@ -1,6 +1,7 @@
 """Correctness of BoxExtraTreesRegressor on object sets: traversal, learning, determinism."""
 import os
 import pickle
+import time
 
 import joblib
 import numpy as np
@@ -10,6 +11,7 @@ from sklearn.metrics import r2_score
 
 import boxtrees._base
 from boxtrees import BoxExtraTreesRegressor, GridCounts, ObjectSets, make_box_regression
+from boxtrees._rows import RowProblem
 from boxtrees._threads import thread_pool
 from conftest import THESIS_FOREST, run_in_fork
 
@@ -201,6 +203,25 @@ def test_a_forest_in_a_pool_thread_predicts_on_its_share_of_the_cores(monkeypatc
     np.testing.assert_array_equal(in_pool, expected)
     with pytest.raises(AssertionError, match="threads of its own"):
         forest.predict(X)           # outside a pool: 2 threads, the caller and one more
+
+
+def test_a_failed_chunk_returns_only_after_the_other_chunks():
+    # the caller's own chunk fails; the pool's chunk, still writing into the output, must
+    # have finished when the error reaches the caller
+    X, y = make_box_regression(500, random_state=0)
+    forest = thesis_forest(n_estimators=4, n_tests=20, n_jobs=2, random_state=0).fit(X, y)
+    finished = []
+
+    def kernel(packed, data, offsets, out):
+        if offsets[0] == 0:
+            raise RuntimeError("first chunk")
+        time.sleep(0.2)
+        finished.append(len(out))
+        return RowProblem.OK, -1
+
+    with pytest.raises(RuntimeError, match="first chunk"):
+        forest._traverse(X, kernel, lambda n: np.empty(n), n_jobs=2)
+    assert finished == [250]
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")

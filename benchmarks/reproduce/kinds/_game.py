@@ -86,8 +86,8 @@ def _capped(value, cap):
 def make_agent(settings, budget, seed, samples):
     """The FQI agent of a registry setting on the game, with the thesis's protocol: up to
     400 training worlds in lockstep (the game's batched engine, through its vector entry
-    point), epsilon 0.2, greedy ties to the first action, the actions' forests fitted and
-    predicted side by side on every core, evaluated on the reference worlds after every
+    point), epsilon 0.2, greedy ties to the first action, the actions' Q-functions
+    predicted side by side (``n_jobs=-1``), evaluated on the reference worlds after every
     iteration; learn it with ``learn(n_iterations=...)``.
 
     Parameters
