@@ -27,8 +27,10 @@ from ._splitter import TEST_KINDS
 from ._threads import thread_pool, threads_for
 from ._typing import SetsOrMatrix
 
-# prediction splits a batch into chunks of at least this many samples, one per thread
+# prediction splits a batch into chunks of at least this many samples, one per thread,
+# the calling thread's and those of the pool of this purpose
 _PREDICT_CHUNK_MIN = 64
+_PREDICT_POOL = "boxtrees-predict"
 # y bands of the training-object index: at most this many, this many for large boxes
 _MAX_BANDS = 32
 _DEFAULT_BANDS = 8
@@ -134,7 +136,8 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         packed = self._packed  # one forest for every chunk, even if another thread refits
         n_chunks = n // _PREDICT_CHUNK_MIN
         if n_chunks > 1:  # threads_for costs as much as predicting one sample
-            n_chunks = min(threads_for(n_jobs), n_chunks)
+            n_threads = threads_for(n_jobs)
+            n_chunks = min(n_threads, n_chunks)
         if n_chunks <= 1:
             results = [kernel(packed, sets.data, sets.offsets, out)]
         else:
@@ -143,10 +146,12 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             def chunk(a, b):
                 return kernel(packed, sets.data, sets.offsets[a : b + 1], out[a:b])
 
-            # the first chunk in this thread, which would otherwise only wait
-            others = [thread_pool(n_chunks - 1).submit(chunk, a, b)
-                      for a, b in zip(edges[1:-1], edges[2:])]
+            # the first chunk in this thread, which would otherwise only wait; the others in
+            # a pool of one thread fewer than the call may use (one pool whatever the batch)
+            pool, others = thread_pool(n_threads - 1, _PREDICT_POOL), []
             try:
+                for a, b in zip(edges[1:-1], edges[2:]):
+                    others.append(pool.submit(chunk, a, b))
                 results = [chunk(edges[0], edges[1])]
             finally:
                 wait(others)    # no chunk outlives the call, even if this one failed

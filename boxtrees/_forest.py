@@ -383,8 +383,9 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
     n_jobs : int, default=None
         Number of parallel jobs for ``fit`` (over trees) and large ``predict`` / ``apply``
         calls (over samples). None means 1 unless in a ``joblib.parallel_backend`` context; -1
-        means all processors. Trees are built with the GIL released. Results do not depend
-        on ``n_jobs``.
+        means all processors. Trees are built with the GIL released. A prediction called
+        from one of the threads of a pool of ``p`` (such as `fqi.FQI`'s per-action threads)
+        uses ``n_jobs / p`` of them, at least 1. Results do not depend on ``n_jobs``.
     random_state : int, RandomState instance or None, default=None
         Seeds the trees: each gets an int ``random_state`` drawn from it. The same value
         gives the same forest whatever ``n_jobs``.

@@ -17,10 +17,12 @@ _LOCAL = threading.local()
 
 
 def _forget_pools_after_fork():
-    """In a forked child: the parent's threads are gone, and the lock may have been held."""
+    """In a forked child: the parent's threads are gone, and the lock may have been held;
+    the child's one thread (the forking one, maybe a pool's) belongs to no pool."""
     global _POOLS_LOCK
     _POOLS.clear()
     _POOLS_LOCK = threading.Lock()
+    vars(_LOCAL).pop("siblings", None)
 
 
 if hasattr(os, "register_at_fork"):
@@ -31,21 +33,22 @@ def _join_pool(n_threads):
     _LOCAL.siblings = n_threads
 
 
-def thread_pool(n_threads: int, purpose: str = "boxtrees-predict") -> ThreadPoolExecutor:
+def thread_pool(n_threads: int, purpose: str) -> ThreadPoolExecutor:
     """The process's pool of `n_threads` threads for `purpose`, started on first use.
 
     Predictions are called once per environment step on batches of a few hundred samples,
     where starting threads (as a joblib ``Parallel`` call does) costs about as much as the
     work; the kernels release the GIL, so long-lived threads share a batch at no such cost.
     Pools of different purposes are distinct, so that work in one pool may wait on work in
-    another (an agent's per-action predictions on a forest's own) without deadlock; work
-    submitted from a pool's thread should take its share of the cores (`threads_for`).
+    another (an agent's per-action predictions on a forest's own) without deadlock, but
+    never on work in its own; work run in a pool's thread takes its share of the cores
+    (`threads_for`).
 
     Parameters
     ----------
     n_threads : int
-    purpose : str, default="boxtrees-predict"
-        Names the pool and its threads.
+    purpose : str
+        Names the pool and its threads ("boxtrees-predict" for a forest's predictions).
 
     Returns
     -------
@@ -64,8 +67,9 @@ def threads_for(n_jobs: int | None) -> int:
     divided among the threads of the pool the calling thread belongs to, if any (at least 1).
 
     A pool's threads already keep that many cores busy: a forest predicting in each of the 2
-    threads of an agent's per-action pool, on 2 cores, predicts in its caller's thread
-    instead of adding 2 threads of its own (4 threads on 2 cores only add switching).
+    threads of an agent's per-action pool, on 2 cores, predicts its whole batch in its
+    caller's thread instead of splitting it with a thread of its own (4 busy threads on 2
+    cores only add switching).
 
     Parameters
     ----------
@@ -75,6 +79,7 @@ def threads_for(n_jobs: int | None) -> int:
     Returns
     -------
     n_threads : int
+        At least 1.
 
     Examples
     --------

@@ -10,9 +10,10 @@ from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.metrics import r2_score
 
 import boxtrees._base
+import boxtrees._threads
 from boxtrees import BoxExtraTreesRegressor, GridCounts, ObjectSets, make_box_regression
 from boxtrees._rows import RowProblem
-from boxtrees._threads import thread_pool
+from boxtrees._threads import thread_pool, threads_for
 from conftest import THESIS_FOREST, run_in_fork
 
 
@@ -203,6 +204,24 @@ def test_a_forest_in_a_pool_thread_predicts_on_its_share_of_the_cores(monkeypatc
     np.testing.assert_array_equal(in_pool, expected)
     with pytest.raises(AssertionError, match="threads of its own"):
         forest.predict(X)           # outside a pool: 2 threads, the caller and one more
+
+
+def test_predictions_of_any_batch_size_share_one_pool():
+    # one pool per thread count, not one per number of chunks a batch makes
+    X, y = make_box_regression(512, random_state=0)
+    forest = thesis_forest(n_estimators=2, n_tests=10, n_jobs=8, random_state=0).fit(X, y)
+    before = set(boxtrees._threads._POOLS)
+    for n in range(128, 513, 64):
+        forest.predict(X[:n])
+    assert set(boxtrees._threads._POOLS) - before <= {("boxtrees-predict", 7)}
+    assert ("boxtrees-predict", 7) in boxtrees._threads._POOLS
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
+def test_a_child_forked_from_a_pool_thread_belongs_to_no_pool():
+    in_pool = thread_pool(2, "test-fork").submit(lambda: (
+        threads_for(2), run_in_fork(lambda: threads_for(2) == 2))).result()
+    assert in_pool == (1, True)
 
 
 def test_a_failed_chunk_returns_only_after_the_other_chunks():

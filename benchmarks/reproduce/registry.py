@@ -258,8 +258,9 @@ EXPERIMENTS = (
                   "200k": {"same_as": "keep_data_horizon/gamma 0.5, 200k"},
                   "all (400k)": {"max_samples": 400_000}},
         notes="On seed 0, the latest 200,000 transitions scored 211,250 against 197,590 "
-              "with 100,000 (gamma 0.5; with gamma 0.8, 205,520 against 189,100): the data "
-              "set's size, not the horizon, moved the kept-data plateau. Here every "
+              "with 100,000 (gamma 0.5; with gamma 0.8, 205,520 against 189,100), about the "
+              "spread between seeds at 100,000 (191,080 to 205,830): one seed suggests the "
+              "data set's size, not the horizon, moves the kept-data plateau. Here every "
               "transition of the run is kept (400,000 at the end)."),
     Experiment(
         "keep_data_boxes", "extra", "Keeping data with bounded boxes", "fqi",
