@@ -91,7 +91,7 @@ class _QFunction:
     def values(self, batch, n_jobs=1):
         """``Q(s, a)`` of every action for the observations of `batch`, shape ``(n,
         n_actions)``, predicted in up to `n_jobs` threads (one action each; a box forest
-        then predicts in its action's thread, see `boxtrees._threads.threads_for`) and
+        then predicts on its share of the cores, see `boxtrees._threads.threads_for`) and
         checked to be one finite value per observation."""
         n_threads = min(threads_for(n_jobs), len(self.models))
         if n_threads == 1:
