@@ -246,11 +246,13 @@ EXPERIMENTS = (
         settings={"gamma 0.5, 100k": {"same_as": "keep_data/keep data (100k)"},
                   "gamma 0.8, 100k": {"gamma": 0.8},
                   "gamma 0.5, 200k": {"max_samples": 200_000},
-                  "gamma 0.8, 200k": {"gamma": 0.8, "max_samples": 200_000}},
+                  "gamma 0.8, 200k": {"gamma": 0.8, "max_samples": 200_000},
+                  "gamma 0.5, all (400k)": {"same_as": "keep_data_size/all (400k)"},
+                  "gamma 0.8, all (400k)": {"gamma": 0.8, "max_samples": 400_000}},
         notes="Kept data plateaus near the scripted heuristic (about 200,000) from iteration "
               "10. Tested: a longer horizon (gamma 0.8: the values of coins 5 steps away "
-              "count), whose backups the kept data can propagate, and twice the data "
-              "(the latest 200,000 transitions, 10 iterations)."),
+              "count), whose backups the kept data can propagate, and twice or four times the "
+              "data (the latest 200,000 transitions, 10 iterations, or every transition)."),
     Experiment(
         "keep_data_size", "extra", "Keeping more data: the latest 100,000 transitions, "
         "200,000, or all of them", "fqi", on_demand=True, defaults=_KEPT_DATA,
