@@ -23,8 +23,10 @@ _MODELS = ("box", "grid")
 @dataclass(frozen=True)
 class ForestSettings(GameSettings):
     """A regressor of the thesis: a box forest (``model="box"``: ``test_type``,
-    ``test_width``, ``n_estimators``, ``n_tests``, ``min_samples_split``) or grid counts
-    with a ridge (``model="grid"``: ``n_bins``, ``alpha``)."""
+    ``test_width``, ``n_estimators``, ``n_tests``, ``min_samples_split``, and
+    ``test_region``, the half-side of the agent-centred square its tests are drawn in, None:
+    the whole view) or grid counts with a ridge (``model="grid"``: ``n_bins``,
+    ``alpha``)."""
 
     model: str = None
     test_type: str = None
@@ -32,6 +34,7 @@ class ForestSettings(GameSettings):
     n_estimators: int = None
     n_tests: int = None
     min_samples_split: int = None
+    test_region: float = None
     n_bins: int = None
     alpha: float = 1.0
 
@@ -43,6 +46,9 @@ class ForestSettings(GameSettings):
         missing = [name for name in needs[self.model] if getattr(self, name) is None]
         if missing:
             raise ValueError(f"a {self.model} model needs {', '.join(missing)}")
+        if self.test_region is not None and not (self.model == "box" and self.test_region > 0):
+            raise ValueError(f"test_region must be a box model's positive half-side, got "
+                             f"{self.test_region!r}")
 
 
 @dataclass(frozen=True)
@@ -76,7 +82,9 @@ def regressor(settings, env, budget, seed):
         env, test_type=settings.test_type, test_width=settings.test_width,
         n_estimators=_capped(settings.n_estimators, budget.max_trees),
         n_tests=_capped(settings.n_tests, budget.max_tests),
-        min_samples_split=settings.min_samples_split, n_jobs=-1, random_state=seed)
+        min_samples_split=settings.min_samples_split, n_jobs=-1, random_state=seed,
+        view_bounds=None if settings.test_region is None else (-settings.test_region,
+                                                               settings.test_region) * 2)
 
 
 def _capped(value, cap):
