@@ -121,7 +121,7 @@ def test_the_tuned_baselines_are_scored_once_per_fqi_iteration(name):
         budget.iterations] * 3
 
 
-def test_an_ablations_game_constants_and_ridge_penalty_reach_its_units():
+def test_an_ablations_game_constants_ridge_penalty_and_test_region_reach_its_units():
     from benchmarks.reproduce.kinds._game import make_env, regressor
 
     def settings(experiment, label):
@@ -136,6 +136,12 @@ def test_an_ablations_game_constants_and_ridge_penalty_reach_its_units():
     assert ridge[0].n_bins == 15 and ridge[-1].alpha == 1000.0
     other = regressor(settings(REGISTRY["fqi_grid"], "N=15"), make_env(grid), TINY, 0)
     assert other[-1].alpha == 1.0
+    near = settings(REGISTRY["keep_data_region"], "near (6)")
+    assert regressor(near, make_env(near), TINY, 0).view_bounds == (-6.0, 6.0, -6.0, 6.0)
+    whole = settings(*resolve(REGISTRY["keep_data_region"], "whole view (10)"))
+    assert regressor(whole, make_env(whole), TINY, 0).view_bounds == (-10.0, 10.0, -10.0, 10.0)
+    with pytest.raises(ValueError, match="test_region"):
+        type(near)(**{**near.__dict__, "test_region": -1.0})
 
 
 def test_the_reference_worlds_are_seeds_fqi_never_trains_on():
