@@ -26,6 +26,8 @@ _STANDARD = {"model": "box", "test_type": "fixed", "test_width": 1.0, "n_estimat
 _TUNED = {**_STANDARD, "n_estimators": 30, "n_tests": 500}
 # Beyond the thesis: the tuned settings on kept data, the latest 100,000 transitions
 _KEPT_DATA = {**_TUNED, "keep_data": True, "max_samples": 100_000}
+# ... and every transition of a full-budget run (20 iterations of 20,000)
+_ALL_KEPT = {**_KEPT_DATA, "max_samples": 400_000}
 _REPRESENTATIONS = {
     "fixed TW=1": {"test_type": "fixed", "test_width": 1.0},
     "bounded TW=4": {"test_type": "bounded", "test_width": 4.0},
@@ -266,7 +268,7 @@ EXPERIMENTS = (
               "transition of the run is kept (400,000 at the end)."),
     Experiment(
         "keep_data_trees", "extra", "Keeping every transition with more trees", "fqi",
-        on_demand=True, defaults={**_KEPT_DATA, "max_samples": 400_000},
+        on_demand=True, defaults=_ALL_KEPT,
         settings={"M=30": {"same_as": "keep_data_size/all (400k)"},
                   "M=60": {"n_estimators": 60}},
         notes="Every transition kept (400,000 at the end) plateaus near 216,000 from "
@@ -274,7 +276,7 @@ EXPERIMENTS = (
               "3.3: M=15 137,682, M=30 146,618): here M=60 against M=30 on the kept data."),
     Experiment(
         "keep_data_region", "extra", "Keeping every transition with tests near the agent",
-        "fqi", on_demand=True, defaults={**_KEPT_DATA, "max_samples": 400_000},
+        "fqi", on_demand=True, defaults=_ALL_KEPT,
         settings={"whole view (10)": {"same_as": "keep_data_size/all (400k)"},
                   "near (6)": {"test_region": 6.0}},
         notes="The most used tests of a learned Q-forest sit within a few units of the agent "
