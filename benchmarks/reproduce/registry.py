@@ -275,15 +275,24 @@ EXPERIMENTS = (
               "iteration 11. More trees scored higher with new data every iteration (Fig. "
               "3.3: M=15 137,682, M=30 146,618): here M=60 against M=30 on the kept data."),
     Experiment(
+        "fqi_region", "extra", "Tests near the agent: the region boxes are drawn in", "fqi",
+        on_demand=True, defaults=_TUNED,
+        settings={"whole view (10)": {"same_as": "sampling/normal"},
+                  "near (6)": {"test_region": 6.0}, "near (4)": {"test_region": 4.0},
+                  "near (3)": {"test_region": 3.0}},
+        notes="The most used tests of a learned Q-forest sit within a few units of the agent "
+              "(the attention figure), and at gamma 0.5 a coin 6 steps away is worth 3% of "
+              "one at hand. Here the boxes' centres are drawn in an agent-centred square of "
+              "half-side 6, 4 or 3 (36%, 16% or 9% of the view's area: each node's K=500 "
+              "tests that much denser there) against the whole 20 x 20 view; new data every "
+              "iteration, M=30, K=500."),
+    Experiment(
         "keep_data_region", "extra", "Keeping every transition with tests near the agent",
         "fqi", on_demand=True, defaults=_ALL_KEPT,
         settings={"whole view (10)": {"same_as": "keep_data_size/all (400k)"},
                   "near (6)": {"test_region": 6.0}},
-        notes="The most used tests of a learned Q-forest sit within a few units of the agent "
-              "(the attention figure), and at gamma 0.5 a coin 6 steps away is worth 3% of "
-              "one at hand. Here the boxes' centres are drawn within 6 units of the agent "
-              "(a 12 x 12 square, 36% of the view's area: each node's K=500 tests are "
-              "about 2.8 times as dense there) against the whole 20 x 20 view."),
+        notes="fqi_region's tests near the agent on the kept data: the boxes' centres "
+              "drawn within 6 units of the agent against the whole view."),
     Experiment(
         "keep_data_boxes", "extra", "Keeping data with bounded boxes", "fqi",
         on_demand=True, defaults=_KEPT_DATA,
