@@ -287,13 +287,6 @@ EXPERIMENTS = (
               "tests that much denser there) against the whole 20 x 20 view; new data every "
               "iteration, M=30, K=500."),
     Experiment(
-        "keep_data_region", "extra", "Keeping every transition with tests near the agent",
-        "fqi", on_demand=True, defaults=_ALL_KEPT,
-        settings={"whole view (10)": {"same_as": "keep_data_size/all (400k)"},
-                  "near (6)": {"test_region": 6.0}},
-        notes="fqi_region's tests near the agent on the kept data: the boxes' centres "
-              "drawn within 6 units of the agent against the whole view."),
-    Experiment(
         "keep_data_boxes", "extra", "Keeping data with bounded boxes", "fqi",
         on_demand=True, defaults=_KEPT_DATA,
         settings={"fixed TW=1": {"same_as": "keep_data/keep data (100k)"},

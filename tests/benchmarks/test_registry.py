@@ -18,7 +18,7 @@ def test_registry_covers_every_thesis_figure_once():
                                       "3.4", "3.5", "3.6", "3.8", "3.9", "3.10"])
     assert {e.name for e in EXPERIMENTS if e.figure == "extra" and not e.explains} == {
         "keep_data", "keep_data_horizon", "keep_data_size", "keep_data_trees",
-        "fqi_region", "keep_data_region", "keep_data_boxes", "keep_data_tests", "dqn",
+        "fqi_region", "keep_data_boxes", "keep_data_tests", "dqn",
         "attention", "ceiling",
         "ceiling_sword",
         "baselines", "baselines_sword", "search_dqn_grid", "search_dqn_objects",
@@ -34,7 +34,7 @@ def test_registry_covers_every_thesis_figure_once():
         assert all(REGISTRY[name].figure != "extra" for name in ablation.explains)
     assert {e.name for e in EXPERIMENTS if e.on_demand} == {
         "keep_data_horizon", "keep_data_size", "keep_data_trees", "fqi_region",
-        "keep_data_region", "keep_data_boxes", "keep_data_tests", "baselines_sword",
+        "keep_data_boxes", "keep_data_tests", "baselines_sword",
         "search_dqn_grid",
         "search_dqn_objects",
         "search_ppo_objects", "control_cartpole",
@@ -136,9 +136,9 @@ def test_an_ablations_game_constants_ridge_penalty_and_test_region_reach_its_uni
     assert ridge[0].n_bins == 15 and ridge[-1].alpha == 1000.0
     other = regressor(settings(REGISTRY["fqi_grid"], "N=15"), make_env(grid), TINY, 0)
     assert other[-1].alpha == 1.0
-    near = settings(REGISTRY["keep_data_region"], "near (6)")
+    near = settings(REGISTRY["fqi_region"], "near (6)")
     assert regressor(near, make_env(near), TINY, 0).view_bounds == (-6.0, 6.0, -6.0, 6.0)
-    whole = settings(*resolve(REGISTRY["keep_data_region"], "whole view (10)"))
+    whole = settings(*resolve(REGISTRY["fqi_region"], "whole view (10)"))
     assert regressor(whole, make_env(whole), TINY, 0).view_bounds == (-10.0, 10.0, -10.0, 10.0)
     with pytest.raises(ValueError, match="test_region"):
         type(near)(**{**near.__dict__, "test_region": -1.0})
