@@ -28,6 +28,8 @@ _TUNED = {**_STANDARD, "n_estimators": 30, "n_tests": 500}
 _KEPT_DATA = {**_TUNED, "keep_data": True, "max_samples": 100_000}
 # ... and every transition of a full-budget run (20 iterations of 20,000)
 _ALL_KEPT = {**_KEPT_DATA, "max_samples": 400_000}
+# Beyond the thesis: box centres drawn in an agent-centred square of these half-sides
+_NEAR = {f"near ({r})": {"test_region": float(r)} for r in (6, 4, 3)}
 _REPRESENTATIONS = {
     "fixed TW=1": {"test_type": "fixed", "test_width": 1.0},
     "bounded TW=4": {"test_type": "bounded", "test_width": 4.0},
@@ -280,15 +282,18 @@ EXPERIMENTS = (
     Experiment(
         "fqi_region", "extra", "Tests near the agent: the region boxes are drawn in", "fqi",
         on_demand=True, defaults=_TUNED,
-        settings={"whole view (10)": {"same_as": "sampling/normal"},
-                  "near (6)": {"test_region": 6.0}, "near (4)": {"test_region": 4.0},
-                  "near (3)": {"test_region": 3.0}},
+        settings={"whole view (10)": {"same_as": "sampling/normal"}, **_NEAR},
         notes="The most used tests of a learned Q-forest sit within a few units of the agent "
               "(the attention figure), and at gamma 0.5 a coin 6 steps away is worth 3% of "
               "one at hand. Here the boxes' centres are drawn in an agent-centred square of "
               "half-side 6, 4 or 3 (36%, 16% or 9% of the view's area: each node's K=500 "
               "tests that much denser there) against the whole 20 x 20 view; new data every "
               "iteration, M=30, K=500."),
+    Experiment(
+        "rmse_region", "extra", "RMSE with tests near the agent", "rmse", on_demand=True,
+        defaults=_TUNED, settings={"whole view (10)": {}, **_NEAR},
+        notes="fqi_region's forests (M=30, K=500) on Appendix A's first regression: how "
+              "well each fits the immediate reward."),
     Experiment(
         "keep_data_boxes", "extra", "Keeping data with bounded boxes", "fqi",
         on_demand=True, defaults=_KEPT_DATA,
