@@ -280,7 +280,7 @@ EXPERIMENTS = (
               "and with gamma 0.8, whose longer horizon needs more precise values (its "
               "M=30 run on the same data scored about as gamma 0.5)."),
     Experiment(
-        "fqi_region", "extra", "Tests near the agent: the region boxes are drawn in", "fqi",
+        "fqi_region", "extra", "Tests near the agent: where the boxes are drawn", "fqi",
         on_demand=True, defaults=_TUNED,
         settings={"whole view (10)": {"same_as": "sampling/normal"}, **_NEAR},
         notes="The most used tests of a learned Q-forest sit within a few units of the agent "
