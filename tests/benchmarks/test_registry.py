@@ -18,7 +18,7 @@ def test_registry_covers_every_thesis_figure_once():
                                       "3.4", "3.5", "3.6", "3.8", "3.9", "3.10"])
     assert {e.name for e in EXPERIMENTS if e.figure == "extra" and not e.explains} == {
         "keep_data", "keep_data_horizon", "keep_data_size", "keep_data_trees",
-        "fqi_region", "rmse_region", "keep_data_boxes", "keep_data_tests", "dqn",
+        "keep_data_nmin", "fqi_region", "rmse_region", "keep_data_boxes", "keep_data_tests", "dqn",
         "attention", "ceiling",
         "ceiling_sword",
         "baselines", "baselines_sword", "search_dqn_grid", "search_dqn_objects",
@@ -33,8 +33,8 @@ def test_registry_covers_every_thesis_figure_once():
         assert ablation.figure == "extra" and ablation.hypothesis and ablation.findings
         assert all(REGISTRY[name].figure != "extra" for name in ablation.explains)
     assert {e.name for e in EXPERIMENTS if e.on_demand} == {
-        "keep_data_horizon", "keep_data_size", "keep_data_trees", "fqi_region",
-        "rmse_region", "keep_data_boxes", "keep_data_tests", "baselines_sword",
+        "keep_data_horizon", "keep_data_size", "keep_data_trees", "keep_data_nmin",
+        "fqi_region", "rmse_region", "keep_data_boxes", "keep_data_tests", "baselines_sword",
         "search_dqn_grid",
         "search_dqn_objects",
         "search_ppo_objects", "control_cartpole",
