@@ -26,8 +26,10 @@ _STANDARD = {"model": "box", "test_type": "fixed", "test_width": 1.0, "n_estimat
 _TUNED = {**_STANDARD, "n_estimators": 30, "n_tests": 500}
 # Beyond the thesis: the tuned settings on kept data, the latest 100,000 transitions
 _KEPT_DATA = {**_TUNED, "keep_data": True, "max_samples": 100_000}
-# ... and every transition of a full-budget run (20 iterations of 20,000)
+# ... and every transition of a full-budget run (20 iterations of 20,000); the settings
+# that run them, which the kept-data ablations compare with
 _ALL_KEPT = {**_KEPT_DATA, "max_samples": 400_000}
+_KEPT_DATA_RUNS, _ALL_KEPT_RUNS = "keep_data/keep data (100k)", "keep_data_size/all (400k)"
 # Beyond the thesis: box centres drawn in an agent-centred square of these half-sides
 _NEAR = {f"near ({r})": {"test_region": float(r)} for r in (6, 4, 3)}
 _REPRESENTATIONS = {
@@ -136,6 +138,14 @@ def _axis(name, figure, title, key, values, label, base, **kwargs):
     """An experiment varying one parameter `key` over `values` (labels ``label(v)``)."""
     settings = {label(v): {key: v} for v in values}
     return Experiment(name, figure, title, defaults=base, settings=settings, **kwargs)
+
+
+def _kept_variant(name, title, defaults, baseline, variant, notes):
+    """An on-demand FQI experiment on kept data: the registered setting ``baseline = (label,
+    "experiment/label")`` against one `variant` (label -> parameters over `defaults`)."""
+    label, owner = baseline
+    return Experiment(name, "extra", title, "fqi", on_demand=True, defaults=defaults,
+                      settings={label: {"same_as": owner}, **variant}, notes=notes)
 
 
 _RMSE = {"kind": "rmse"}
@@ -247,11 +257,11 @@ EXPERIMENTS = (
     Experiment(
         "keep_data_horizon", "extra", "Keeping data with a longer horizon or more data",
         "fqi", on_demand=True, defaults=_KEPT_DATA,
-        settings={"gamma 0.5, 100k": {"same_as": "keep_data/keep data (100k)"},
+        settings={"gamma 0.5, 100k": {"same_as": _KEPT_DATA_RUNS},
                   "gamma 0.8, 100k": {"gamma": 0.8},
                   "gamma 0.5, 200k": {"max_samples": 200_000},
                   "gamma 0.8, 200k": {"gamma": 0.8, "max_samples": 200_000},
-                  "gamma 0.5, all (400k)": {"same_as": "keep_data_size/all (400k)"},
+                  "gamma 0.5, all (400k)": {"same_as": _ALL_KEPT_RUNS},
                   "gamma 0.8, all (400k)": {"gamma": 0.8, "max_samples": 400_000}},
         notes="Kept data plateaus near the scripted heuristic (about 200,000) from iteration "
               "10. Tested: a longer horizon (gamma 0.8: the values of coins 5 steps away "
@@ -260,7 +270,7 @@ EXPERIMENTS = (
     Experiment(
         "keep_data_size", "extra", "Keeping more data: the latest 100,000 transitions, "
         "200,000, or all of them", "fqi", on_demand=True, defaults=_KEPT_DATA,
-        settings={"100k": {"same_as": "keep_data/keep data (100k)"},
+        settings={"100k": {"same_as": _KEPT_DATA_RUNS},
                   "200k": {"same_as": "keep_data_horizon/gamma 0.5, 200k"},
                   "all (400k)": {"max_samples": 400_000}},
         notes="On seed 0, the latest 200,000 transitions scored 211,250 against 197,590 "
@@ -268,19 +278,15 @@ EXPERIMENTS = (
               "spread between seeds at 100,000 (191,080 to 205,830): one seed suggests the "
               "data set's size, not the horizon, moves the kept-data plateau. Here every "
               "transition of the run is kept (400,000 at the end)."),
-    Experiment(
-        "keep_data_trees", "extra", "Keeping every transition with more trees", "fqi",
-        on_demand=True, defaults=_ALL_KEPT,
-        settings={"M=30": {"same_as": "keep_data_size/all (400k)"},
-                  "M=60": {"n_estimators": 60}},
+    _kept_variant(
+        "keep_data_trees", "Keeping every transition with more trees", _ALL_KEPT,
+        ("M=30", _ALL_KEPT_RUNS), {"M=60": {"n_estimators": 60}},
         notes="Every transition kept (400,000 at the end) plateaus near 216,000 from "
               "iteration 11. More trees scored higher with new data every iteration (Fig. "
               "3.3: M=15 137,682, M=30 146,618): here M=60 against M=30 on the kept data."),
-    Experiment(
-        "keep_data_nmin", "extra", "Keeping every transition with larger leaves", "fqi",
-        on_demand=True, defaults=_ALL_KEPT,
-        settings={"n_min=30": {"same_as": "keep_data_size/all (400k)"},
-                  "n_min=100": {"min_samples_split": 100}},
+    _kept_variant(
+        "keep_data_nmin", "Keeping every transition with larger leaves", _ALL_KEPT,
+        ("n_min=30", _ALL_KEPT_RUNS), {"n_min=100": {"min_samples_split": 100}},
         notes="n_min=30 was tuned on 5,000 samples per action (Fig. 3.1); with every "
               "transition kept a forest learns on up to 100,000, and a leaf of 30 averages "
               "targets that one enemy (-300) or coin (+100) moves by several units. Here "
@@ -300,21 +306,18 @@ EXPERIMENTS = (
         defaults=_TUNED, settings={"whole view (10)": {}, **_NEAR},
         notes="fqi_region's forests (M=30, K=500) on Appendix A's first regression: how "
               "well each fits the immediate reward."),
-    Experiment(
-        "keep_data_boxes", "extra", "Keeping data with bounded boxes", "fqi",
-        on_demand=True, defaults=_KEPT_DATA,
-        settings={"fixed TW=1": {"same_as": "keep_data/keep data (100k)"},
-                  "bounded TW=2.5": {"test_type": "bounded", "test_width": 2.5}},
+    _kept_variant(
+        "keep_data_boxes", "Keeping data with bounded boxes", _KEPT_DATA,
+        ("fixed TW=1", _KEPT_DATA_RUNS),
+        {"bounded TW=2.5": {"test_type": "bounded", "test_width": 2.5}},
         notes="Bounded boxes of half-width up to 2.5 peaked highest in Fig. 3.4 (best "
               "evaluation 164,000 against fixed TW=1's 161,100; scores 133,664 and 137,682; "
               "M=15, K=300, new data every iteration); here they learn on the kept data "
               "(the latest 100,000 transitions), at M=30, K=500, against the kept-data "
               "fixed boxes (about 200,000)."),
-    Experiment(
-        "keep_data_tests", "extra", "Keeping data with more tests per node", "fqi",
-        on_demand=True, defaults=_KEPT_DATA,
-        settings={"K=500": {"same_as": "keep_data/keep data (100k)"},
-                  "K=1000": {"n_tests": 1000}},
+    _kept_variant(
+        "keep_data_tests", "Keeping data with more tests per node", _KEPT_DATA,
+        ("K=500", _KEPT_DATA_RUNS), {"K=1000": {"n_tests": 1000}},
         notes="More tests per node scored higher at every step of Fig. A.1/3.2 (K=300: "
               "137,682, K=500: 151,068, new data every iteration); the kept data (the "
               "latest 100,000 transitions) hold 5 times as many samples per fit, on which "
@@ -592,7 +595,7 @@ EXPERIMENTS += (
         defaults={"step_scale": 1.0, "checkpoints": 20, "max_objects": 32,
                   "attention": False},
         settings={_FQI_BOX: {"same_as": "representations/fixed TW=1"},
-                  _FQI_KEEP: {"same_as": "keep_data/keep data (100k)"},
+                  _FQI_KEEP: {"same_as": _KEPT_DATA_RUNS},
                   **_TUNED_BASELINES,
                   "look-ahead planner": {"same_as": "ceiling/look-ahead planner"},
                   "greedy heuristic": {"same_as": "ceiling/greedy heuristic"}},
