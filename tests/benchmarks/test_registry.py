@@ -1,6 +1,8 @@
 """The experiment registry: every thesis figure once, settings that resolve, rules on real
 settings, budgets, and the registry settings the other benchmarks build on."""
 
+import dataclasses
+
 import pytest
 
 from benchmarks.reproduce import BUDGETS, EXPERIMENTS, REGISTRY
@@ -141,7 +143,7 @@ def test_an_ablations_game_constants_ridge_penalty_and_test_region_reach_its_uni
     whole = settings(*resolve(REGISTRY["fqi_region"], "whole view (10)"))
     assert regressor(whole, make_env(whole), TINY, 0).view_bounds == (-10.0, 10.0, -10.0, 10.0)
     with pytest.raises(ValueError, match="test_region"):
-        type(near)(**{**near.__dict__, "test_region": -1.0})
+        dataclasses.replace(near, test_region=-1.0)
 
 
 def test_the_reference_worlds_are_seeds_fqi_never_trains_on():
