@@ -22,7 +22,7 @@ from gymnasium.envs.registration import register
 
 from ._rules import (
     ACTION_NAMES, ARROW, ENEMY, GRASS, MONEY, MONEY_MARKER, REFERENCE_SEED_START,
-    TREASURE_MARKER, TYPE_NAMES, VIEWS, WALL, WorldRules, reference_worlds,
+    TREASURE_MARKER, TYPE_NAMES, VIEWS, WALL, WorldRules, move_frame, reference_worlds,
 )
 from ._render import TYPE_COLOURS
 from .batched import BatchedObjectWorld, RaggedBatch
@@ -34,7 +34,7 @@ from .wrappers import PaddedObjects, strip_padding
 __all__ = [
     "ObjectWorldEnv", "BatchedObjectWorld", "RaggedBatch", "WorldRules", "PaddedObjects",
     "strip_padding", "GreedyPolicy", "reference_worlds", "REFERENCE_SEED_START",
-    "LookaheadPlanner",
+    "LookaheadPlanner", "move_frame",
     "MONEY", "WALL", "GRASS", "ENEMY", "MONEY_MARKER", "TREASURE_MARKER", "ARROW",
     "TYPE_NAMES", "TYPE_COLOURS", "ACTION_NAMES", "VIEWS",
     "AtariObjects", "atari_games", "HighwayObjects",

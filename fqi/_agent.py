@@ -1,10 +1,11 @@
 """`FQI`: fitted Q-iteration with one scikit-learn regressor per action, on any gymnasium env."""
 from __future__ import annotations
 
+import functools
 import inspect
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from contextlib import contextmanager
 from typing import Any, Self
 
@@ -161,14 +162,21 @@ class FQI:
         removes the upward bias of ``max_a Q(s', a)`` over fitting errors. Actions follow
         the mean of the two. With `leaf_backups` each half's leaves hold the means of its
         own half's targets.
-    action_input : bool, default=False
-        Fit one regressor on every transition, its input the observation followed by the
-        action's one-hot columns (``X`` has ``n_features + n_actions`` columns), instead of
-        one regressor per action on that action's transitions (as MushroomRL's FQI with a
-        state-action regressor). The actions then share the regressor's splits on the
-        observation, so their Q-values err together where separate regressors err apart
-        (the likely reason it plays better on Acrobot-v1, not measured apart:
-        ``docs/fqi.md``). Feature-vector (``Box``) observations only; not with `double`.
+    action_input : bool or callable, default=False
+        Fit one regressor on every transition, its input the observation encoded with its
+        action, instead of one regressor per action on that action's transitions (as
+        MushroomRL's FQI with a state-action regressor). True: the observation followed by
+        the action's one-hot columns (``X`` has ``n_features + n_actions`` columns;
+        feature-vector, ``Box``, observations only). A callable ``encode(observations,
+        actions)``: the regressor's input is what it returns for a batch of observations
+        (as the regressor takes them: an array, or a `boxtrees.ObjectSets`) and their
+        actions, one row or set per observation; an env symmetric under a group of
+        transformations that permutes its actions can turn each observation so that its
+        action points one way, and the actions then share one model and all the data
+        (``benchmarks`` does so on the thesis's game). The actions share the regressor's
+        splits, so their Q-values err together where separate regressors err apart (the
+        likely reason it plays better on Acrobot-v1, not measured apart: ``docs/fqi.md``).
+        Not with `double`. A callable must pickle (a module-level function) for `save`.
     n_envs : int, default=None
         Envs played side by side while collecting; None: the vector env's own number, or
         16 for any other env form.
@@ -258,7 +266,8 @@ class FQI:
                  exploration_fraction: float = 0.1, exploration_initial_eps: float = 1.0,
                  exploration_final_eps: float = 0.05,
                  exploration_zeta: float | None = None, tie_break: str = "random",
-                 leaf_backups: int = 0, double: bool = False, action_input: bool = False,
+                 leaf_backups: int = 0, double: bool = False,
+                 action_input: bool | Callable[[Any, np.ndarray], Any] = False,
                  n_envs: int | None = None,
                  eval_episodes: int | None = None, eval_seeds: Sequence[int] | None = None,
                  eval_env: EnvLike | None = None, n_jobs: int = 1,
@@ -319,7 +328,11 @@ class FQI:
                             f"each sample in each tree, as scikit-learn's forests have); "
                             f"{type(regressor).__name__} has none")
         self.double = _check_bool("double", params["double"])
-        self.action_input = _check_bool("action_input", params["action_input"])
+        action_input = params["action_input"]
+        if not callable(action_input) and not isinstance(action_input, (bool, np.bool_)):
+            raise TypeError(f"action_input must be a bool or a callable encode(observations, "
+                            f"actions), got {action_input!r}")
+        self.action_input = action_input if callable(action_input) else bool(action_input)
         if self.double and self.action_input:
             raise ValueError("double and action_input cannot be combined: Double FQI fits "
                              "a regressor per action on each half of the data")
@@ -401,10 +414,17 @@ class FQI:
     def _check_action_input(self, observations, observation_space):
         """ValueError if `action_input` is asked of observations that are not feature
         vectors (`observations`: the format of `observation_space`)."""
-        if self.action_input and isinstance(observations, _ObjectRows):
-            raise ValueError(f"action_input needs feature-vector (Box) observations, not "
+        if self.action_input is True and isinstance(observations, _ObjectRows):
+            raise ValueError(f"action_input=True needs feature-vector (Box) observations, not "
                              f"{observation_space}: the action is appended to each "
-                             f"observation's features")
+                             f"observation's features; pass a callable encode(observations, "
+                             f"actions) for other observations")
+
+    def _encoder(self, n_actions):
+        """`action_input`'s encoding of observations with their actions (of `n_actions`)."""
+        if callable(self.action_input):
+            return self.action_input
+        return functools.partial(_with_actions, n_actions=n_actions)
 
     def _check_regressor(self, observations, batch, n_actions):
         """Fit a clone of the regressor on `batch` (zero targets; distinct ones with
@@ -412,7 +432,13 @@ class FQI:
         observation with an action of the `n_actions` appended) and check its predictions,
         so that a regressor that cannot take these observations fails now."""
         if self.action_input:
-            batch = _with_actions(batch, np.arange(len(batch)) % n_actions, n_actions)
+            encoded = self._encoder(n_actions)(batch, np.arange(len(batch)) % n_actions)
+            length = len(encoded) if hasattr(encoded, "__len__") else None
+            if length != len(batch):
+                raise ValueError(f"action_input={self.action_input!r} must return one input "
+                                 f"per observation; for {len(batch)} observations it "
+                                 f"returned a {type(encoded).__name__} of length {length}")
+            batch = encoded
         model = clone(self.regressor)
         # distinct targets when the leaves' means are checked (leaf_backups), else zeros
         y = np.arange(len(batch), dtype=float) * self.leaf_backups
@@ -633,7 +659,8 @@ class FQI:
             args = (self.regressor, self._data, targets, self.n_actions, self._fit_rng,
                     self._q, self.iteration)
             self._q = (_DoubleQFunction.fit(*args, split) if self.double
-                       else _ActionInputQFunction.fit(*args) if self.action_input
+                       else _ActionInputQFunction.fit(*args, self._encoder(self.n_actions))
+                       if self.action_input
                        else _QFunction.fit(*args))
         with _timed(times, "t_evaluate"):
             result = (evaluate(self, self._eval_env, seeds=self._eval_seeds)

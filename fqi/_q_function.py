@@ -108,23 +108,28 @@ class _QFunction:
 
 
 class _ActionInputQFunction:
-    """``Q_n`` as one regressor over each observation followed by its action's one-hot
-    columns (FQI's ``action_input``): the actions share its splits on the observation, so
-    their Q-values err together, where one regressor per action errs for each apart.
-    Feature-vector observations.
+    """``Q_n`` as one regressor over each observation encoded with its action (FQI's
+    ``action_input``): by default the observation followed by the action's one-hot columns
+    (`_with_actions`), or the user's encoding. The actions share its splits on the
+    observation, so their Q-values err together, where one regressor per action errs for
+    each apart; an encoding that maps symmetric state-actions to one input also shares
+    their data.
 
     Parameters
     ----------
     model : regressor
-        Fitted on ``_with_actions(states, actions, n_actions)``.
+        Fitted on ``encode(states, actions)``.
     n_actions : int
-        The number of actions: one-hot columns after the observation's.
+        The number of actions.
     iteration : int
         The iteration that fitted it (named in errors).
+    encode : callable
+        ``encode(observations, actions)``: the regressor's input, one row per observation.
     """
 
-    def __init__(self, model, n_actions, iteration):
+    def __init__(self, model, n_actions, iteration, encode):
         self.model, self.n_actions, self.iteration = model, n_actions, iteration
+        self.encode = encode
 
     @property
     def models(self):
@@ -132,18 +137,18 @@ class _ActionInputQFunction:
         return [self.model]
 
     @classmethod
-    def fit(cls, regressor, data, targets, n_actions, rng, previous, iteration):
+    def fit(cls, regressor, data, targets, n_actions, rng, previous, iteration, encode):
         """A clone of `regressor` (its ``random_state`` parameters drawn from `rng`) fitted
-        on every transition; `previous` is unused (every action is in the input)."""
+        on every transition, encoded; `previous` is unused (every action is in the input)."""
         model = _seeded_clone(regressor, rng)
-        return cls(model.fit(_with_actions(data.states, data.actions, n_actions), targets),
-                   n_actions, iteration)
+        return cls(model.fit(encode(data.states, data.actions), targets), n_actions,
+                   iteration, encode)
 
     def _every_action(self, batch):
-        """Each observation of `batch` with each action in turn: ``n_actions`` rows per
-        observation, observation by observation."""
-        return _with_actions(np.repeat(batch, self.n_actions, axis=0),
-                             np.tile(np.arange(self.n_actions), len(batch)), self.n_actions)
+        """Each observation of `batch` with each action in turn, encoded: ``n_actions`` rows
+        per observation, observation by observation."""
+        return self.encode(batch[np.repeat(np.arange(len(batch)), self.n_actions)],
+                           np.tile(np.arange(self.n_actions), len(batch)))
 
     def values(self, batch, n_jobs=1):
         """``Q(s, a)`` of every action for the observations of `batch`, shape ``(n,
@@ -160,7 +165,7 @@ class _ActionInputQFunction:
     def backups(self, data, targets, discounts, n_backups, split=None):
         """`_QFunction.backups` on the one regressor: its leaves hold the mean targets of
         every transition that reaches them, whatever its action."""
-        table = _LeafTable(self.model, _with_actions(data.states, data.actions, self.n_actions),
+        table = _LeafTable(self.model, self.encode(data.states, data.actions),
                            self._every_action(data.next_states))
         for _ in range(n_backups):
             q = table.next_values(targets).reshape(len(data), self.n_actions)
@@ -169,8 +174,9 @@ class _ActionInputQFunction:
 
 
 def _with_actions(states, actions, n_actions):
-    """The rows of the observation matrix `states` followed by the one-hot columns of
-    `actions` (``n_actions`` columns, in the matrix's dtype)."""
+    """The encoding of ``action_input=True``: the rows of the observation matrix `states`
+    followed by the one-hot columns of `actions` (``n_actions`` columns, in the matrix's
+    dtype)."""
     onehot = np.zeros((len(states), n_actions), dtype=states.dtype)
     onehot[np.arange(len(states)), actions] = 1
     return np.hstack([states, onehot])

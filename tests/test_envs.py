@@ -676,3 +676,57 @@ def test_greedy_policy_needs_an_objectworld_env(make_env):
 ])
 def test_greedy_policy_takes_objectworld_envs_wrapped_or_not(make_env):
     assert envs.GreedyPolicy(make_env()).rules == envs.WorldRules(sword=True)
+
+
+# --------------------------------------------------------------------------- symmetry
+def test_move_frame_turns_each_move_up_and_keeps_distances():
+    directions = np.array([[0, 1], [1, 0], [0, -1], [-1, 0]] * 2, dtype=np.float32)
+    np.testing.assert_array_equal(envs.move_frame(directions, np.arange(8)),
+                                  np.tile([0.0, 1.0], (8, 1)))
+    points = np.random.default_rng(0).normal(size=(40, 2)).astype(np.float32)
+    actions = np.arange(40) % 4
+    turned = envs.move_frame(points, actions)
+    np.testing.assert_array_equal(np.linalg.norm(turned, axis=1), np.linalg.norm(points, axis=1))
+    # four quarter turns come back where they started
+    again = points
+    for _ in range(4):
+        again = envs.move_frame(again, np.ones(40, dtype=int))
+    np.testing.assert_array_equal(again, points)
+    assert envs.move_frame(np.empty((0, 2)), np.empty(0, dtype=int)).shape == (0, 2)
+
+
+@pytest.mark.parametrize("positions, actions, problem", [
+    (np.zeros((3, 3)), np.zeros(3, dtype=int), "must be \\(n, 2\\)"),
+    (np.zeros((3, 2)), np.zeros(2, dtype=int), "must be \\(n, 2\\)"),
+    (np.zeros((1, 2)), np.array([8]), "range\\(8\\)"),
+    (np.zeros((1, 2)), np.array([-1]), "range\\(8\\)"),
+    (np.zeros((1, 2)), np.array([1.5]), "integers"),
+])
+def test_move_frame_refuses_bad_input(positions, actions, problem):
+    with pytest.raises(ValueError, match=problem):
+        envs.move_frame(positions, actions)
+
+
+@pytest.mark.parametrize("quarter_turns", [1, 2, 3])
+@pytest.mark.parametrize("enemy_speed", [0.0, 0.2])
+def test_a_turned_world_plays_the_turned_moves_alike(quarter_turns, enemy_speed):
+    """What `move_frame` relies on: a world turned by quarter turns, played with the moves
+    turned alike, gives the turned observations and the same rewards."""
+    rng = np.random.default_rng(quarter_turns)
+    n = 300
+    objects = np.column_stack([rng.uniform(-27, 27, size=(n, 2)), rng.integers(0, 4, n)])
+    objects = objects[np.linalg.norm(objects[:, :2], axis=1) > 2].astype(np.float32)
+    turn = np.full(len(objects), quarter_turns)
+    turned = np.column_stack([envs.move_frame(objects[:, :2], turn), objects[:, 2]])
+    env, obs = scripted(objects, enemy_speed=enemy_speed)
+    turned_env, turned_obs = scripted(turned, enemy_speed=enemy_speed)
+    rewards = []
+    for move in rng.integers(0, 4, 7).repeat(7):     # straight runs, to meet objects
+        expected = np.column_stack([envs.move_frame(obs[:, :2], np.full(len(obs), quarter_turns)),
+                                    obs[:, 2]])
+        np.testing.assert_array_equal(np.unique(turned_obs, axis=0), np.unique(expected, axis=0))
+        obs, reward, *_ = env.step(move)
+        turned_obs, turned_reward, *_ = turned_env.step((move - quarter_turns) % 4)
+        assert turned_reward == reward
+        rewards.append(reward)
+    assert np.count_nonzero(rewards) >= 2, rewards    # the walk met objects

@@ -1,12 +1,15 @@
-"""FQI with one regressor over observations and actions (``FQI(action_input=True)``): the
-observation followed by the action's one-hot columns is the regressor's input."""
+"""FQI with one regressor over observations and actions (``FQI(action_input=...)``): with
+True the observation followed by the action's one-hot columns is the regressor's input; a
+callable encodes them its own way."""
+import functools
+
 import gymnasium as gym
 import numpy as np
 import pytest
 from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.linear_model import LinearRegression
 
-from boxtrees import BoxExtraTreesRegressor
+from boxtrees import BoxExtraTreesRegressor, ObjectSets
 from fqi import FQI
 from fqi._q_function import _ActionInputQFunction, _with_actions
 
@@ -18,6 +21,10 @@ def test_the_input_is_the_observation_then_the_actions_one_hot_columns():
     assert joint.dtype == np.float32
 
 
+def _one_hot(n_actions):
+    return functools.partial(_with_actions, n_actions=n_actions)
+
+
 def _linear_q(states):
     """A Q-function linear in the state, with an offset per action (3 actions)."""
     return (2 * states[:, :1] - states[:, 1:2]) + np.array([0.0, 1.5, -4.0])
@@ -27,7 +34,7 @@ def test_one_regressor_fitted_on_every_transition_values_every_action(random_tra
     data = random_transitions(300, 2, 3)
     targets = _linear_q(data.states)[np.arange(300), data.actions]
     q = _ActionInputQFunction.fit(LinearRegression(), data, targets, 3,
-                                  np.random.default_rng(0), None, 7)
+                                  np.random.default_rng(0), None, 7, _one_hot(3))
     assert len(q.models) == 1 and q.iteration == 7
     assert q.models[0].n_features_in_ == 2 + 3
     probe = np.random.default_rng(1).normal(size=(20, 2))
@@ -41,7 +48,7 @@ def test_leaf_backups_average_every_transitions_targets_in_the_one_forest(random
     rng = np.random.default_rng(1)
     fitted_on = rng.normal(size=150)
     forest = ExtraTreesRegressor(n_estimators=3, min_samples_split=10, random_state=0)
-    q = _ActionInputQFunction.fit(forest, data, fitted_on, 3, rng, None, 0)
+    q = _ActionInputQFunction.fit(forest, data, fitted_on, 3, rng, None, 0, _one_hot(3))
     discounts = np.where(data.terminated, 0.0, 0.9)
     # on the targets it was fitted on, a backup is the fitted values' bootstrap
     np.testing.assert_allclose(q.backups(data, fitted_on, discounts, 1),
@@ -87,14 +94,14 @@ def test_action_input_needs_feature_vectors_and_no_double(cartpole_fqi, tmp_path
         def step(self, action):
             return (np.array([1.0, -2.0, 0.0], dtype=np.float32),), 0.0, False, False, {}
 
-    with pytest.raises(ValueError, match="action_input needs feature-vector"):
+    with pytest.raises(ValueError, match="action_input=True needs feature-vector"):
         FQI(ExtraTreesRegressor(n_estimators=2), ObjectEnv(), action_input=True,
             eval_episodes=0, n_envs=1)
     # nor can a saved agent on object sets take it up when loaded (without an env)
     agent = FQI(BoxExtraTreesRegressor(n_estimators=2), ObjectEnv(), eval_episodes=0,
                 n_envs=1)
     agent.save(tmp_path / "objects.joblib")
-    with pytest.raises(ValueError, match="action_input needs feature-vector"):
+    with pytest.raises(ValueError, match="action_input=True needs feature-vector"):
         FQI.load(tmp_path / "objects.joblib", action_input=True)
 
 
@@ -113,3 +120,69 @@ def test_action_input_learns_offline_from_a_mapping():
     np.testing.assert_array_equal(q[:, 1], model.predict(np.hstack([x[:10], one_hot])))
     # three fits of a reward of 1 per step: values between 1 and 1 + 0.99 + 0.99 ** 2
     assert (q >= 1 - 1e-9).all() and (q <= 1 + 0.99 + 0.99**2 + 1e-9).all()
+
+
+def _cartpole_one_hot(states, actions):
+    """`action_input=True`'s encoding of CartPole's two actions, as a callable (module-level,
+    so that a saved agent pickles it)."""
+    return _with_actions(states, actions, 2)
+
+
+def test_a_callable_action_input_encodes_the_regressors_input(cartpole_fqi, tmp_path):
+    obs = np.random.default_rng(0).normal(size=(50, 4)).astype(np.float32)
+    joint = cartpole_fqi(action_input=True).learn(total_timesteps=1000)
+    encoded = cartpole_fqi(action_input=_cartpole_one_hot).learn(total_timesteps=1000)
+    np.testing.assert_array_equal(encoded.q_values(obs), joint.q_values(obs))
+    encoded.save(tmp_path / "encoded.joblib")
+    loaded = FQI.load(tmp_path / "encoded.joblib")
+    assert loaded.action_input is _cartpole_one_hot
+    np.testing.assert_array_equal(loaded.q_values(obs), joint.q_values(obs))
+
+
+class _OneObjectEnv(gym.Env):
+    """Object sets of one object, type 0, anywhere in [-5, 5]^2; action 1 pays 1, action 0
+    nothing; episodes of one step."""
+
+    observation_space = gym.spaces.Sequence(gym.spaces.Box(-5.0, 5.0, shape=(3,)))
+    action_space = gym.spaces.Discrete(2)
+
+    def _observation(self):
+        return (np.float32([*self.np_random.uniform(-5, 5, size=2), 0.0]),)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        return self._observation(), {}
+
+    def step(self, action):
+        return self._observation(), float(action), True, False, {}
+
+
+def _with_an_action_object(sets, actions):
+    """Each set with one more object at the origin, of type ``1 + action``."""
+    marks = np.zeros((len(sets), 3), dtype=sets.data.dtype)
+    marks[:, 2] = 1 + np.asarray(actions)
+    return ObjectSets.from_sequence([np.vstack([rows, mark]) for rows, mark in zip(sets, marks)])
+
+
+def test_a_callable_action_input_learns_one_model_of_object_sets():
+    agent = FQI(BoxExtraTreesRegressor(n_estimators=20, random_state=0), _OneObjectEnv(),
+                action_input=_with_an_action_object, gamma=0.5, samples_per_iteration=400,
+                n_envs=4, eval_episodes=0, seed=0)
+    agent.learn(total_timesteps=800)
+    (model,) = agent.q_functions_
+    # the one forest tells the actions apart by the objects the encoding added: type 2
+    # appears in its input only through the encoding
+    assert model.n_types_ == 3
+    probe = [np.float32([[x, -x, 0.0]]) for x in np.linspace(-4, 4, 9)]
+    q = agent.q_values(probe)
+    np.testing.assert_allclose(q[:, 0], 0.0, atol=0.05)
+    np.testing.assert_allclose(q[:, 1], 1.0, atol=0.05)
+
+
+def test_a_bad_action_input_is_refused(cartpole_fqi):
+    with pytest.raises(TypeError, match="action_input must be a bool or a callable"):
+        cartpole_fqi(action_input="yes")
+    with pytest.raises(ValueError, match="double and action_input cannot be combined"):
+        cartpole_fqi(action_input=_cartpole_one_hot, double=True)
+    with pytest.raises(ValueError, match="must return one input per observation"):
+        cartpole_fqi(action_input=lambda states, actions: _cartpole_one_hot(states, actions)[1:])

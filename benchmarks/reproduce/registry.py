@@ -303,6 +303,26 @@ EXPERIMENTS = (
               "tests that much denser there) against the whole 20 x 20 view; new data every "
               "iteration, M=30, K=500."),
     Experiment(
+        "fqi_frame", "extra", "One forest in the move's frame", "fqi", on_demand=True,
+        defaults=_TUNED,
+        settings={"a forest per move": {"same_as": "sampling/normal"},
+                  "move frame": {"move_frame": True}},
+        notes="The game is symmetric under quarter turns, so Q(s, a) is Q(s', up) for s' the "
+              "state turned so that move a points up (envs.move_frame). One forest of moving "
+              "up then learns from the transitions of all four moves, each observation turned "
+              "into its move's frame (FQI's action_input encoding): four times the data per "
+              "forest for about the same cost. New data every iteration, M=30, K=500."),
+    _kept_variants(
+        "keep_data_frame", "Keeping every transition, in the move's frame",
+        {**_ALL_KEPT, "min_samples_split": 100},
+        ("a forest per move", "keep_data_nmin/n_min=100"),
+        {"move frame": {"move_frame": True},
+         "move frame, n_min=300": {"move_frame": True, "min_samples_split": 300}},
+        notes="fqi_frame's one forest on every transition of the run (up to 400,000, all of "
+              "them in each fit) against the best kept-data setting, a forest per move with "
+              "n_min=100; n_min=300 keeps the leaves of the four times larger data set about "
+              "as many as a forest per move has."),
+    Experiment(
         "rmse_region", "extra", "RMSE with tests near the agent", "rmse", on_demand=True,
         defaults=_TUNED, settings={"whole view (10)": {}, **_NEAR},
         notes="fqi_region's forests (M=30, K=500) on Appendix A's first regression: how "

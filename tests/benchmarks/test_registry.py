@@ -3,12 +3,14 @@ settings, budgets, and the registry settings the other benchmarks build on."""
 
 import dataclasses
 
+import numpy as np
 import pytest
 
 from benchmarks.reproduce import BUDGETS, EXPERIMENTS, REGISTRY
 from benchmarks.reproduce.kinds import KINDS
 from benchmarks.reproduce.registry import Experiment, resolve
 from benchmarks.reproduce.runner import plan
+from boxtrees import ObjectSets
 
 from harness import TINY
 
@@ -20,7 +22,8 @@ def test_registry_covers_every_thesis_figure_once():
                                       "3.4", "3.5", "3.6", "3.8", "3.9", "3.10"])
     assert {e.name for e in EXPERIMENTS if e.figure == "extra" and not e.explains} == {
         "keep_data", "keep_data_horizon", "keep_data_size", "keep_data_trees",
-        "keep_data_nmin", "fqi_region", "rmse_region", "keep_data_boxes", "keep_data_tests", "dqn",
+        "keep_data_nmin", "fqi_region", "rmse_region", "fqi_frame", "keep_data_frame",
+        "keep_data_boxes", "keep_data_tests", "dqn",
         "attention", "ceiling",
         "ceiling_sword",
         "baselines", "baselines_sword", "search_dqn_grid", "search_dqn_objects",
@@ -36,7 +39,8 @@ def test_registry_covers_every_thesis_figure_once():
         assert all(REGISTRY[name].figure != "extra" for name in ablation.explains)
     assert {e.name for e in EXPERIMENTS if e.on_demand} == {
         "keep_data_horizon", "keep_data_size", "keep_data_trees", "keep_data_nmin",
-        "fqi_region", "rmse_region", "keep_data_boxes", "keep_data_tests", "baselines_sword",
+        "fqi_region", "rmse_region", "fqi_frame", "keep_data_frame", "keep_data_boxes",
+        "keep_data_tests", "baselines_sword",
         "search_dqn_grid",
         "search_dqn_objects",
         "search_ppo_objects", "control_cartpole",
@@ -144,6 +148,30 @@ def test_an_ablations_game_constants_ridge_penalty_and_test_region_reach_its_uni
     assert regressor(whole, make_env(whole), TINY, 0).view_bounds == (-10.0, 10.0, -10.0, 10.0)
     with pytest.raises(ValueError, match="test_region"):
         dataclasses.replace(near, test_region=-1.0)
+
+
+def test_a_move_frame_agent_fits_one_forest_on_every_move_turned_up():
+    from benchmarks.reproduce.kinds._game import in_move_frame, make_agent
+
+    experiment = REGISTRY["fqi_frame"]
+    settings = KINDS["fqi"].settings(experiment.params("move frame"))
+    agent = make_agent(settings, TINY, 0, 200)
+    assert agent.action_input is in_move_frame
+    agent.learn(n_iterations=1)
+    assert len(agent.q_functions_) == 1
+    sets = ObjectSets(np.float32([[1, 2, 0], [3, -4, 3], [-1, 0, 1]]), [0, 2, 3])
+    turned = in_move_frame(sets, np.array([1, 3]))
+    np.testing.assert_array_equal(turned.data, [[-2, 1, 0], [4, 3, 3], [0, 1, 1]])
+    np.testing.assert_array_equal(turned.offsets, sets.offsets)
+    # Q(s, a) is the one forest's value of s turned into a's frame
+    q = agent.q_values(sets)
+    (forest,) = agent.q_functions_
+    for action in range(4):
+        np.testing.assert_array_equal(
+            q[:, action], forest.predict(in_move_frame(sets, np.full(2, action))))
+    sword = dataclasses.replace(settings, env_id="ObjectWorldSword-v0")
+    with pytest.raises(ValueError, match="move_frame needs the game of four moves"):
+        make_agent(sword, TINY, 0, 200)
 
 
 def test_the_reference_worlds_are_seeds_fqi_never_trains_on():

@@ -3,14 +3,17 @@ regressors of a setting and the FQI agent of the thesis's protocol."""
 from dataclasses import dataclass
 
 import gymnasium as gym
+import numpy as np
 
 import envs
+from boxtrees import ObjectSets
 from fqi import FQI, make_box_forest, make_grid_ridge
 
 from ._base import GameSettings
 
 __all__ = ["GAMMA", "ForestSettings", "AgentSettings", "make_env", "reference_seeds",
-           "regressor", "make_agent", "forest_cost", "actions_cost", "agent_cost"]
+           "regressor", "in_move_frame", "make_agent", "forest_cost", "actions_cost",
+           "agent_cost"]
 
 # Discount factor of every FQI and DQN run (the thesis does not state one; 0.5 scored best
 # in the measured comparison of docs/fqi.md, "Discount factor"). Pinned here so a changed
@@ -54,13 +57,15 @@ class ForestSettings(GameSettings):
 @dataclass(frozen=True)
 class AgentSettings(ForestSettings):
     """An FQI agent of the thesis's protocol with its regressor: ``gamma``, collections
-    every ``resample_every`` iterations, and ``keep_data`` up to ``max_samples``
-    transitions (default: one iteration's)."""
+    every ``resample_every`` iterations, ``keep_data`` up to ``max_samples`` transitions
+    (default: one iteration's), and with ``move_frame`` one regressor of every move seen in
+    its own frame (`in_move_frame`) instead of one per move."""
 
     gamma: float = GAMMA
     resample_every: int = 1
     keep_data: bool = False
     max_samples: int = None
+    move_frame: bool = False
 
 
 def make_env(settings, **kwargs):
@@ -85,6 +90,16 @@ def regressor(settings, env, budget, seed):
         min_samples_split=settings.min_samples_split, n_jobs=-1, random_state=seed,
         view_bounds=None if settings.test_region is None else (-settings.test_region,
                                                                settings.test_region) * 2)
+
+
+def in_move_frame(observations, actions):
+    """FQI's ``action_input`` encoding of the game's observations: each object set turned
+    into the frame of its move (`envs.move_frame`), so that one regressor, of moving up,
+    learns from the transitions of all four moves."""
+    turned = observations.data.copy()
+    turned[:, :2] = envs.move_frame(turned[:, :2],
+                                    np.asarray(actions)[observations.sample_index()])
+    return ObjectSets(turned, observations.offsets, observations.type_names)
 
 
 def _capped(value, cap):
@@ -112,11 +127,16 @@ def make_agent(settings, budget, seed, samples):
     agent : fqi.FQI
     """
     env = make_env(settings)
+    if settings.move_frame and env.action_space.n != 4:
+        env.close()
+        raise ValueError(f"move_frame needs the game of four moves; {settings.env_id} with "
+                         f"{settings.rules} has {env.action_space.n} actions")
     return FQI(regressor(settings, env, budget, seed), env, gamma=settings.gamma,
                samples_per_iteration=samples, resample_every=settings.resample_every,
                keep_data=settings.keep_data,
                max_samples=max(settings.max_samples or samples, samples),
                exploration_initial_eps=THESIS_EPSILON, exploration_final_eps=THESIS_EPSILON,
+               action_input=in_move_frame if settings.move_frame else False,
                tie_break="first", n_envs=min(400, samples), n_jobs=-1,
                eval_seeds=reference_seeds(env, budget), seed=seed)
 
