@@ -1,7 +1,6 @@
 """`FQI`: fitted Q-iteration with one scikit-learn regressor per action, on any gymnasium env."""
 from __future__ import annotations
 
-import functools
 import inspect
 import os
 import time
@@ -27,7 +26,7 @@ from ._evaluate import _eval_seeds, evaluate
 from ._logger import CSVLogger, _KeyValueLogger
 from ._observations import _ObjectRows, _observation_format
 from ._q_function import (_ActionInputQFunction, _check_leaf_means, _checked_prediction,
-                          _DoubleQFunction, _QFunction, _with_actions)
+                          _DoubleQFunction, _encoded, _QFunction)
 from ._saving import _read_save, _write_save
 from ._typing import Callback, Dataset, EnvLike, Logger, Observation, Regressor
 
@@ -420,11 +419,10 @@ class FQI:
                              f"observation's features; pass a callable encode(observations, "
                              f"actions) for other observations")
 
-    def _encoder(self, n_actions):
-        """`action_input`'s encoding of observations with their actions (of `n_actions`)."""
-        if callable(self.action_input):
-            return self.action_input
-        return functools.partial(_with_actions, n_actions=n_actions)
+    def _encoding(self):
+        """`action_input`'s encoding for `_ActionInputQFunction`: the callable, or None for
+        the one-hot columns."""
+        return self.action_input if callable(self.action_input) else None
 
     def _check_regressor(self, observations, batch, n_actions):
         """Fit a clone of the regressor on `batch` (zero targets; distinct ones with
@@ -432,7 +430,8 @@ class FQI:
         observation with an action of the `n_actions` appended) and check its predictions,
         so that a regressor that cannot take these observations fails now."""
         if self.action_input:
-            encoded = self._encoder(n_actions)(batch, np.arange(len(batch)) % n_actions)
+            encoded = _encoded(self._encoding(), batch, np.arange(len(batch)) % n_actions,
+                               n_actions)
             length = len(encoded) if hasattr(encoded, "__len__") else None
             if length != len(batch):
                 raise ValueError(f"action_input={self.action_input!r} must return one input "
@@ -659,7 +658,7 @@ class FQI:
             args = (self.regressor, self._data, targets, self.n_actions, self._fit_rng,
                     self._q, self.iteration)
             self._q = (_DoubleQFunction.fit(*args, split) if self.double
-                       else _ActionInputQFunction.fit(*args, self._encoder(self.n_actions))
+                       else _ActionInputQFunction.fit(*args, self._encoding())
                        if self.action_input
                        else _QFunction.fit(*args))
         with _timed(times, "t_evaluate"):

@@ -123,9 +123,12 @@ class _ActionInputQFunction:
         The number of actions.
     iteration : int
         The iteration that fitted it (named in errors).
-    encode : callable
-        ``encode(observations, actions)``: the regressor's input, one row per observation.
+    encode : callable or None
+        ``encode(observations, actions)``: the regressor's input, one row per observation;
+        None: `_with_actions`.
     """
+
+    encode = None  # (and so in the saves of versions that had no other encoding)
 
     def __init__(self, model, n_actions, iteration, encode):
         self.model, self.n_actions, self.iteration = model, n_actions, iteration
@@ -141,14 +144,14 @@ class _ActionInputQFunction:
         """A clone of `regressor` (its ``random_state`` parameters drawn from `rng`) fitted
         on every transition, encoded; `previous` is unused (every action is in the input)."""
         model = _seeded_clone(regressor, rng)
-        return cls(model.fit(encode(data.states, data.actions), targets), n_actions,
-                   iteration, encode)
+        return cls(model.fit(_encoded(encode, data.states, data.actions, n_actions), targets),
+                   n_actions, iteration, encode)
 
     def _every_action(self, batch):
         """Each observation of `batch` with each action in turn, encoded: ``n_actions`` rows
         per observation, observation by observation."""
-        return self.encode(batch[np.repeat(np.arange(len(batch)), self.n_actions)],
-                           np.tile(np.arange(self.n_actions), len(batch)))
+        return _encoded(self.encode, batch[np.repeat(np.arange(len(batch)), self.n_actions)],
+                        np.tile(np.arange(self.n_actions), len(batch)), self.n_actions)
 
     def values(self, batch, n_jobs=1):
         """``Q(s, a)`` of every action for the observations of `batch`, shape ``(n,
@@ -165,12 +168,21 @@ class _ActionInputQFunction:
     def backups(self, data, targets, discounts, n_backups, split=None):
         """`_QFunction.backups` on the one regressor: its leaves hold the mean targets of
         every transition that reaches them, whatever its action."""
-        table = _LeafTable(self.model, self.encode(data.states, data.actions),
+        table = _LeafTable(self.model,
+                           _encoded(self.encode, data.states, data.actions, self.n_actions),
                            self._every_action(data.next_states))
         for _ in range(n_backups):
             q = table.next_values(targets).reshape(len(data), self.n_actions)
             targets = data.rewards + discounts * q.max(axis=1)
         return targets
+
+
+def _encoded(encode, states, actions, n_actions):
+    """The observations `states` encoded with their `actions` (of `n_actions`) by `encode`,
+    or by `_with_actions` if it is None."""
+    if encode is None:
+        return _with_actions(states, actions, n_actions)
+    return encode(states, actions)
 
 
 def _with_actions(states, actions, n_actions):

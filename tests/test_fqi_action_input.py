@@ -1,7 +1,7 @@
 """FQI with one regressor over observations and actions (``FQI(action_input=...)``): with
 True the observation followed by the action's one-hot columns is the regressor's input; a
 callable encodes them its own way."""
-import functools
+import pickle
 
 import gymnasium as gym
 import numpy as np
@@ -21,10 +21,6 @@ def test_the_input_is_the_observation_then_the_actions_one_hot_columns():
     assert joint.dtype == np.float32
 
 
-def _one_hot(n_actions):
-    return functools.partial(_with_actions, n_actions=n_actions)
-
-
 def _linear_q(states):
     """A Q-function linear in the state, with an offset per action (3 actions)."""
     return (2 * states[:, :1] - states[:, 1:2]) + np.array([0.0, 1.5, -4.0])
@@ -34,7 +30,7 @@ def test_one_regressor_fitted_on_every_transition_values_every_action(random_tra
     data = random_transitions(300, 2, 3)
     targets = _linear_q(data.states)[np.arange(300), data.actions]
     q = _ActionInputQFunction.fit(LinearRegression(), data, targets, 3,
-                                  np.random.default_rng(0), None, 7, _one_hot(3))
+                                  np.random.default_rng(0), None, 7, None)
     assert len(q.models) == 1 and q.iteration == 7
     assert q.models[0].n_features_in_ == 2 + 3
     probe = np.random.default_rng(1).normal(size=(20, 2))
@@ -43,12 +39,24 @@ def test_one_regressor_fitted_on_every_transition_values_every_action(random_tra
                                atol=1e-9)
 
 
+def test_a_q_function_pickled_before_encodings_existed_reads_the_one_hot_columns(
+        random_transitions):
+    data = random_transitions(100, 2, 3)
+    targets = _linear_q(data.states)[np.arange(100), data.actions]
+    q = _ActionInputQFunction.fit(LinearRegression(), data, targets, 3,
+                                  np.random.default_rng(0), None, 0, None)
+    del q.encode      # the attributes an older version pickled
+    old = pickle.loads(pickle.dumps(q))
+    probe = np.random.default_rng(1).normal(size=(20, 2))
+    np.testing.assert_allclose(old.values(probe), _linear_q(probe), atol=1e-9)
+
+
 def test_leaf_backups_average_every_transitions_targets_in_the_one_forest(random_transitions):
     data = random_transitions(150, 2, 3)
     rng = np.random.default_rng(1)
     fitted_on = rng.normal(size=150)
     forest = ExtraTreesRegressor(n_estimators=3, min_samples_split=10, random_state=0)
-    q = _ActionInputQFunction.fit(forest, data, fitted_on, 3, rng, None, 0, _one_hot(3))
+    q = _ActionInputQFunction.fit(forest, data, fitted_on, 3, rng, None, 0, None)
     discounts = np.where(data.terminated, 0.0, 0.9)
     # on the targets it was fitted on, a backup is the fitted values' bootstrap
     np.testing.assert_allclose(q.backups(data, fitted_on, discounts, 1),
