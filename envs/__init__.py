@@ -22,19 +22,20 @@ from gymnasium.envs.registration import register
 
 from ._rules import (
     ACTION_NAMES, ARROW, ENEMY, GRASS, MONEY, MONEY_MARKER, REFERENCE_SEED_START,
-    TREASURE_MARKER, TYPE_NAMES, VIEWS, WALL, WorldRules, move_frame, reference_worlds,
+    TREASURE_MARKER, TYPE_NAMES, VIEWS, WALL, WorldRules, reference_worlds,
 )
 from ._render import TYPE_COLOURS
 from .batched import BatchedObjectWorld, RaggedBatch
 from .object_world import ObjectWorldEnv
 from .planner import LookaheadPlanner
 from .policies import GreedyPolicy
+from .symmetry import in_move_frame, move_frame
 from .wrappers import PaddedObjects, strip_padding
 
 __all__ = [
     "ObjectWorldEnv", "BatchedObjectWorld", "RaggedBatch", "WorldRules", "PaddedObjects",
     "strip_padding", "GreedyPolicy", "reference_worlds", "REFERENCE_SEED_START",
-    "LookaheadPlanner", "move_frame",
+    "LookaheadPlanner", "move_frame", "in_move_frame",
     "MONEY", "WALL", "GRASS", "ENEMY", "MONEY_MARKER", "TREASURE_MARKER", "ARROW",
     "TYPE_NAMES", "TYPE_COLOURS", "ACTION_NAMES", "VIEWS",
     "AtariObjects", "atari_games", "HighwayObjects",

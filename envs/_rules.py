@@ -11,7 +11,7 @@ import numpy as np
 __all__ = [
     "MONEY", "WALL", "GRASS", "ENEMY", "MONEY_MARKER", "TREASURE_MARKER", "ARROW",
     "TYPE_NAMES", "ACTION_NAMES", "VIEWS", "WorldRules", "reference_worlds",
-    "REFERENCE_SEED_START", "move_frame",
+    "REFERENCE_SEED_START",
 ]
 
 # Object type ids (column 2 of an observation row).
@@ -30,64 +30,6 @@ _REWARD_ENEMY = -300.0
 _REWARD_SWIPE_ONE = 300.0
 _REWARD_SWIPE_MANY = -900.0
 _REWARD_SWIPE_NONE = -750.0
-
-# cos and sin of k quarter turns counter-clockwise, k = 0..3: k turns take move k's direction
-# to up's (the moves go round clockwise)
-_TURN_COS = np.array([1.0, 0.0, -1.0, 0.0], dtype=np.float32)
-_TURN_SIN = np.array([0.0, 1.0, 0.0, -1.0], dtype=np.float32)
-
-
-def move_frame(positions, actions):
-    """Agent-relative positions seen in the frame of a move: turned by quarter turns so that
-    the move points up.
-
-    The game is symmetric under quarter turns of the world (a square with the agent at its
-    centre, objects spawned uniformly, isotropic noise and contacts): turning a state and
-    its move together gives a state-move pair that plays out alike. So ``Q(s, a)`` is ``Q(s',
-    up)`` for ``s'`` the state seen in the frame of move ``a``, and one model of moving up,
-    learned from the transitions of all four moves, gives every move's value (pass this to
-    FQI's ``action_input`` through an encoding of the observations; the benchmarks' game
-    agents do). A swipe ``a + 4`` is turned as move ``a``: it points the same way.
-
-    Parameters
-    ----------
-    positions : array-like of shape (n, 2)
-        Agent-relative ``[dx, dy]`` of objects (the first two columns of observation rows).
-    actions : array-like of int of shape (n,)
-        The action of each position's observation, in ``range(8)``.
-
-    Returns
-    -------
-    turned : ndarray of shape (n, 2), float32
-        Exact: a quarter turn only swaps and negates coordinates.
-
-    Raises
-    ------
-    ValueError
-        If the shapes do not match or an action is outside ``range(8)``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from envs import move_frame
-    >>> directions = [[0, 1], [1, 0], [0, -1], [-1, 0]]   # up, right, down, left
-    >>> move_frame(directions, [0, 1, 2, 3]).tolist()
-    [[0.0, 1.0], [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]]
-    """
-    positions = np.asarray(positions, dtype=np.float32)
-    actions = np.asarray(actions)
-    if positions.ndim != 2 or positions.shape[1] != 2 or actions.shape != positions.shape[:1]:
-        raise ValueError(f"positions must be (n, 2) and actions (n,); got {positions.shape} "
-                         f"and {actions.shape}")
-    if not np.issubdtype(actions.dtype, np.integer) and actions.size:
-        raise ValueError(f"actions must be integers, got dtype {actions.dtype}")
-    if actions.size and (actions.min() < 0 or actions.max() >= len(ACTION_NAMES)):
-        raise ValueError(f"actions must lie in range({len(ACTION_NAMES)})")
-    k = actions.astype(np.intp) % 4
-    c, s = _TURN_COS[k], _TURN_SIN[k]
-    x, y = positions[:, 0], positions[:, 1]
-    return np.stack([c * x - s * y, s * x + c * y], axis=1)
-
 
 VIEWS = ("local", "global", "minimap", "arrow")
 

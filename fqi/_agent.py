@@ -172,7 +172,7 @@ class FQI:
         actions, one row or set per observation; an env symmetric under a group of
         transformations that permutes its actions can turn each observation so that its
         action points one way, and the actions then share one model and all the data
-        (``benchmarks`` does so on the thesis's game). The actions share the regressor's
+        (``envs.in_move_frame`` does so for the thesis's game). The actions share the regressor's
         splits, so their Q-values err together where separate regressors err apart (the
         likely reason it plays better on Acrobot-v1, not measured apart: ``docs/fqi.md``).
         Not with `double`. A callable must pickle (a module-level function) for `save`.

@@ -695,6 +695,18 @@ def test_move_frame_turns_each_move_up_and_keeps_distances():
     assert envs.move_frame(np.empty((0, 2)), np.empty(0, dtype=int)).shape == (0, 2)
 
 
+def test_in_move_frame_turns_each_observation_by_its_own_action():
+    data = np.float32([[1, 2, 0], [3, -4, 3], [-1, 0, 1], [5, 5, 2]])
+    batch = envs.RaggedBatch(data, [0, 2, 2, 4])
+    turned = envs.in_move_frame(batch, [1, 0, 3])
+    assert isinstance(turned, envs.RaggedBatch)
+    np.testing.assert_array_equal(turned.offsets, batch.offsets)
+    np.testing.assert_array_equal(turned.data, [[-2, 1, 0], [4, 3, 3], [0, 1, 1], [5, -5, 2]])
+    np.testing.assert_array_equal(batch.data, data)      # the input is left as it was
+    with pytest.raises(ValueError, match="one action per observation"):
+        envs.in_move_frame(batch, [1, 0])
+
+
 @pytest.mark.parametrize("positions, actions, problem", [
     (np.zeros((3, 3)), np.zeros(3, dtype=int), "must be \\(n, 2\\)"),
     (np.zeros((3, 2)), np.zeros(2, dtype=int), "must be \\(n, 2\\)"),

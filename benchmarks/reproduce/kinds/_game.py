@@ -3,17 +3,14 @@ regressors of a setting and the FQI agent of the thesis's protocol."""
 from dataclasses import dataclass
 
 import gymnasium as gym
-import numpy as np
 
 import envs
-from boxtrees import ObjectSets
 from fqi import FQI, make_box_forest, make_grid_ridge
 
 from ._base import GameSettings
 
 __all__ = ["GAMMA", "ForestSettings", "AgentSettings", "make_env", "reference_seeds",
-           "regressor", "in_move_frame", "make_agent", "forest_cost", "actions_cost",
-           "agent_cost"]
+           "regressor", "make_agent", "forest_cost", "actions_cost", "agent_cost"]
 
 # Discount factor of every FQI and DQN run (the thesis does not state one; 0.5 scored best
 # in the measured comparison of docs/fqi.md, "Discount factor"). Pinned here so a changed
@@ -59,7 +56,7 @@ class AgentSettings(ForestSettings):
     """An FQI agent of the thesis's protocol with its regressor: ``gamma``, collections
     every ``resample_every`` iterations, ``keep_data`` up to ``max_samples`` transitions
     (default: one iteration's), and with ``move_frame`` one regressor of every move seen in
-    its own frame (`in_move_frame`) instead of one per move."""
+    its own frame (`envs.in_move_frame`) instead of one per move."""
 
     gamma: float = GAMMA
     resample_every: int = 1
@@ -90,16 +87,6 @@ def regressor(settings, env, budget, seed):
         min_samples_split=settings.min_samples_split, n_jobs=-1, random_state=seed,
         view_bounds=None if settings.test_region is None else (-settings.test_region,
                                                                settings.test_region) * 2)
-
-
-def in_move_frame(observations, actions):
-    """FQI's ``action_input`` encoding of the game's observations: each object set turned
-    into the frame of its move (`envs.move_frame`), so that one regressor, of moving up,
-    learns from the transitions of all four moves."""
-    turned = observations.data.copy()
-    turned[:, :2] = envs.move_frame(turned[:, :2],
-                                    np.asarray(actions)[observations.sample_index()])
-    return ObjectSets(turned, observations.offsets, observations.type_names)
 
 
 def _capped(value, cap):
@@ -136,7 +123,7 @@ def make_agent(settings, budget, seed, samples):
                keep_data=settings.keep_data,
                max_samples=max(settings.max_samples or samples, samples),
                exploration_initial_eps=THESIS_EPSILON, exploration_final_eps=THESIS_EPSILON,
-               action_input=in_move_frame if settings.move_frame else False,
+               action_input=envs.in_move_frame if settings.move_frame else False,
                tie_break="first", n_envs=min(400, samples), n_jobs=-1,
                eval_seeds=reference_seeds(env, budget), seed=seed)
 
