@@ -124,8 +124,9 @@ class FQI:
     exploration_zeta : float or None, default=None
         None: each random action lasts one step (epsilon-greedy). A number ``mu > 1``:
         temporally-extended epsilon-greedy ("ez-greedy", "Temporally-Extended
-        epsilon-Greedy Exploration", ICLR 2021): an env that is not holding an action starts, with the probability of a random
-        action, to hold a uniformly drawn action for ``n`` steps, ``n`` drawn from the zeta
+        epsilon-Greedy Exploration", ICLR 2021): an env that is not holding an action
+        starts, with the probability of a random action, to hold a uniformly drawn action
+        for ``n`` steps, ``n`` drawn from the zeta
         distribution of exponent ``mu`` (``P(n) ~ n**-mu``: mostly short, sometimes long;
         capped at 10,000 steps; a hold may run on into the env's next episode), and acts
         greedily otherwise; the first round holds random actions the same way. Random play
