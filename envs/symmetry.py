@@ -2,15 +2,14 @@
 move, where the move points up."""
 import numpy as np
 
-from ._rules import ACTION_NAMES
+from ._rules import _DIRECTIONS, ACTION_NAMES
 from .batched import RaggedBatch
 
 __all__ = ["move_frame", "in_move_frame"]
 
-# cos and sin of k quarter turns counter-clockwise, k = 0..3: k turns take move k's direction
-# to up's (the moves go round clockwise)
-_TURN_COS = np.array([1.0, 0.0, -1.0, 0.0], dtype=np.float32)
-_TURN_SIN = np.array([0.0, 1.0, 0.0, -1.0], dtype=np.float32)
+# The turn that takes move k's unit direction (dx, dy) to up's, (0, 1): the rotation whose
+# cosine is dy and sine dx
+_TURN_SIN, _TURN_COS = _DIRECTIONS.T.astype(np.float32)
 
 
 def move_frame(positions, actions):
