@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import inspect
 import warnings
+from collections.abc import Mapping
 from concurrent.futures import wait
 from dataclasses import dataclass
 from math import ceil
@@ -63,7 +64,7 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         "max_retries": [Interval(Integral, 0, _INT32_MAX, closed="both")],
         "refine_tests": ["boolean"],
         "max_depth": [Interval(Integral, 0, _INT32_MAX, closed="both"), None],
-        "view_bounds": ["array-like", Interval(Real, 0, None, closed="neither"), None],
+        "view_bounds": ["array-like", Interval(Real, 0, None, closed="neither"), dict, None],
         "column_groups": [list, tuple, None],
         "relative_width": ["boolean"],
     }
@@ -465,12 +466,19 @@ class _TrainingObjects:
         low, high = spanned[:, 0], spanned[:, 1]
         estimator.n_types_ = n_types = len(estimator.types_)
         estimator.column_groups_ = groups = _column_groups(estimator.column_groups, d)
-        if estimator.view_bounds is not None:
+        per_type = isinstance(estimator.view_bounds, Mapping)
+        if per_type and features:
+            raise ValueError("view_bounds as a mapping of type ids applies to object sets; a "
+                             "feature matrix takes one (low, high) for every column")
+        if estimator.view_bounds is not None and not per_type:
             region = np.tile(check_view_bounds(estimator.view_bounds, d), (n_types, 1))
         elif features:        # each column's own range
             region = np.column_stack([low, high])
         else:
             region = np.tile(_with_margin(low, high).ravel(), (n_types, 1))
+        if per_type:
+            for object_type, bounds in _type_regions(estimator.view_bounds, d).items():
+                region[estimator.types_ == object_type] = bounds
         estimator.bounds_ = region.astype(np.float32)
         width = float(estimator.test_width)
         if estimator.relative_width:
@@ -503,8 +511,7 @@ class _TrainingObjects:
 
     def _index_objects(self, estimator, sets, position):
         data, groups, n_types = sets.data, estimator.column_groups_, estimator.n_types_
-        edges = [_band_edges(estimator, self.bounds[g * n_types], self.half_widths[g * n_types, 1])
-                 for g in range(len(groups))]
+        edges = [_band_edges(estimator, *self._group_extent(g, n_types)) for g in range(len(groups))]
         n_bands = max(len(e) for e in edges) - 1
         # every group has n_bands bands; the last ones of a group with fewer are empty
         self.band_edges = np.array([np.pad(e, (0, n_bands + 1 - len(e)), constant_values=np.inf)
@@ -515,6 +522,27 @@ class _TrainingObjects:
         if (self.group_sizes > 2).any():   # their further columns are read in the rows
             self.attributes = np.ascontiguousarray(data[:, :estimator.n_attributes_])
             self.object_of = object_of
+
+
+    def _group_extent(self, group, n_types):
+        """The y extent that the regions of a column group's types span, ``(ymin, ymax)``, and
+        their smallest y half-width (what the group's bands are cut for)."""
+        mine = slice(group * n_types, (group + 1) * n_types)
+        return (self.bounds[mine, 2].min(), self.bounds[mine, 3].max(),
+                self.half_widths[mine, 1].min())
+
+
+def _type_regions(view_bounds, n_attributes):
+    """A mapping ``view_bounds`` validated: type id -> its region as `check_view_bounds` gives
+    it (``2 * n_attributes`` floats)."""
+    regions = {}
+    for object_type, bounds in view_bounds.items():
+        if not isinstance(object_type, Integral) or isinstance(object_type, bool):
+            raise TypeError(f"view_bounds as a mapping takes type ids (ints) as keys; got "
+                            f"{object_type!r}")
+        regions[int(object_type)] = check_view_bounds(bounds, n_attributes,
+                                                      name=f"view_bounds[{object_type!r}]")
+    return regions
 
 
 def _with_margin(low, high):
@@ -552,15 +580,15 @@ def _column_groups(column_groups, n_attributes):
     return tuple(groups)
 
 
-def _band_edges(estimator, bounds, y_half_width):
+def _band_edges(estimator, y0, y1, y_half_width):
     """Edges of the y bands that index the training objects of one column group (an internal
-    speed-up), from its region ``bounds`` ``(xmin, xmax, ymin, ymax)``.
+    speed-up), from the y extent ``(y0, y1)`` of its regions.
 
     Bands about twice as tall as a fixed or bounded box (measured best) let a test skip most
     objects of its type; wholly covered bands need no y test. A group of one column (an
     unbounded y extent) has one band.
     """
-    y0, y1 = float(bounds[2]), float(bounds[3])
+    y0, y1 = float(y0), float(y1)
     if not np.isfinite(y0):
         return np.array([-np.inf, np.inf])
     if estimator.test_type in ("fixed", "bounded"):

@@ -16,7 +16,7 @@ from sklearn.utils.validation import check_is_fitted
 from ._base import BaseBoxTrees, ClassificationTargets, RegressionTargets
 from ._builder import build_tree
 from ._tree import BoxTree
-from ._typing import RandomStateLike, SetsOrMatrix, TestType, fit_context
+from ._typing import RandomStateLike, SetsOrMatrix, TestType, ViewBounds, fit_context
 
 __all__ = ["BoxExtraTreeClassifier", "BoxExtraTreeRegressor"]
 
@@ -60,7 +60,7 @@ class _SingleTree(BaseBoxTrees):
         test_width: float = 0.1,
         max_retries: int = 10,
         max_depth: int | None = None,
-        view_bounds: ArrayLike | float | None = None,
+        view_bounds: ViewBounds | None = None,
         column_groups: Sequence[int | Sequence[int]] | None = None,
         relative_width: bool = True,
         refine_tests: bool = True,

@@ -18,7 +18,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from ._base import _INT32_MAX, BaseBoxTrees, ClassificationTargets, RegressionTargets, _Bootstrap
 from ._extra_tree import _SEED_MAX, BoxExtraTreeClassifier, BoxExtraTreeRegressor
-from ._typing import RandomStateLike, SetsOrMatrix, TestType, fit_context
+from ._typing import RandomStateLike, SetsOrMatrix, TestType, ViewBounds, fit_context
 
 __all__ = ["BoxExtraTreesClassifier", "BoxExtraTreesRegressor"]
 
@@ -68,7 +68,7 @@ class _Forest(BaseBoxTrees):
         test_width: float = 0.1,
         max_retries: int = 10,
         max_depth: int | None = None,
-        view_bounds: ArrayLike | float | None = None,
+        view_bounds: ViewBounds | None = None,
         column_groups: Sequence[int | Sequence[int]] | None = None,
         relative_width: bool = True,
         refine_tests: bool = True,
@@ -333,11 +333,15 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
         rounds before making it a leaf.
     max_depth : int, default=None
         Maximum tree depth; None grows until the other stopping rules apply.
-    view_bounds : array-like of 2 * d floats or float, default=None
+    view_bounds : array-like of 2 * d floats, float, dict or None, default=None
         Sampling region ``(low_1, high_1, ..., low_d, high_d)`` (for ``[x, y, type]``
         objects, ``(xmin, xmax, ymin, ymax)``), or a half-width ``r`` for ``[-r, r]^d``.
         None: the bounding box of the training objects (for a feature matrix: each node's
-        range of the tested column).
+        range of the tested column). A dict gives object types their own regions, ``{type
+        id: region}`` (each region as above), for objects whose tests matter in different
+        places: a region near the agent for the walls it may walk into, the whole view for
+        the coins it walks towards; types it does not name are drawn in the training
+        objects' bounding box, and names of types absent at fit are ignored.
     column_groups : sequence of sequences of int, default=None
         The groups of attributes a test's box may span, each of 1 to 8 distinct attribute
         indices (an int is a group of one); each test draws one group. None: the first two
@@ -534,7 +538,7 @@ class BoxExtraTreesClassifier(ClassificationTargets, _Forest):
         test_width: float = 0.1,
         max_retries: int = 10,
         max_depth: int | None = None,
-        view_bounds: ArrayLike | float | None = None,
+        view_bounds: ViewBounds | None = None,
         column_groups: Sequence[int | Sequence[int]] | None = None,
         relative_width: bool = True,
         refine_tests: bool = True,

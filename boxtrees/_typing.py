@@ -2,7 +2,7 @@
 scikit-learn decorators on its public functions and ``fit`` methods."""
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Literal, Protocol, TypeAlias, TypeVar
 
 import numpy as np
@@ -13,7 +13,7 @@ from sklearn.utils._param_validation import validate_params as _validate_params
 from ._objects import ObjectSets
 
 __all__ = ["RaggedRows", "SetsOrMatrix", "ObjectSetsInput", "RandomStateLike", "TestType",
-           "fit_context", "validate_params"]
+           "ViewBounds", "fit_context", "validate_params"]
 
 
 class RaggedRows(Protocol):
@@ -34,6 +34,8 @@ ObjectSetsInput: TypeAlias = ObjectSets | RaggedRows | Sequence[ArrayLike]
 SetsOrMatrix: TypeAlias = ObjectSetsInput | ArrayLike
 RandomStateLike: TypeAlias = int | np.random.RandomState | None
 TestType: TypeAlias = Literal["fixed", "bounded", "random", "classic"]
+# A sampling region (low, high per attribute, or a half-width), or one per type id.
+ViewBounds: TypeAlias = ArrayLike | float | Mapping[int, ArrayLike | float]
 
 _Function = TypeVar("_Function", bound=Callable[..., Any])
 

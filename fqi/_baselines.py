@@ -1,7 +1,7 @@
 """The regressors compared in the thesis: its box forest and grid counts with a ridge."""
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import gymnasium as gym
 import numpy as np
@@ -10,11 +10,11 @@ from sklearn.linear_model import Ridge
 from sklearn.pipeline import Pipeline, make_pipeline
 
 from boxtrees import BoxExtraTreesRegressor, GridCounts
-from boxtrees._typing import RandomStateLike, TestType
+from boxtrees._typing import RandomStateLike, TestType, ViewBounds
 
 from ._checks import _check_int, _check_n_jobs, _check_real
 from ._envs import _spaces
-from ._observations import _object_bounds, _view_bounds
+from ._observations import _object_bounds, _type_ids, _view_bounds
 from ._typing import EnvLike
 
 __all__ = ["make_box_forest", "make_grid_ridge"]
@@ -23,7 +23,7 @@ def make_box_forest(env: EnvLike | None = None, *, test_type: TestType = "fixed"
                     test_width: float = 1.0, n_estimators: int = 30, n_tests: int = 500,
                     min_samples_split: int | float = 30, n_jobs: int | None = -1,
                     random_state: RandomStateLike = None,
-                    view_bounds: Sequence[float] | None = None) -> BoxExtraTreesRegressor:
+                    view_bounds: ViewBounds | None = None) -> BoxExtraTreesRegressor:
     """A `boxtrees.BoxExtraTreesRegressor` drawing its tests in the env's view square.
 
     The thesis's forest: its tuned parameters are the defaults (M=30, K=500, n_min=30, fixed
@@ -42,8 +42,10 @@ def make_box_forest(env: EnvLike | None = None, *, test_type: TestType = "fixed"
     test_type, test_width, n_estimators, n_tests, min_samples_split, n_jobs, random_state
         As in `boxtrees.BoxExtraTreesRegressor` (``n_jobs=-1``: every core), and checked
         here against its parameter constraints rather than at the first fit.
-    view_bounds : tuple of 2 * d floats, default=None
-        ``(xmin, xmax, ymin, ymax)`` (``(low, high)`` per attribute), instead of the env's.
+    view_bounds : tuple of 2 * d floats or dict, default=None
+        ``(xmin, xmax, ymin, ymax)`` (``(low, high)`` per attribute), instead of the env's;
+        or ``{type id: region}``, regions of their own for some types (as
+        `boxtrees.BoxExtraTreesRegressor` takes them), the env's for the others.
 
     Returns
     -------
@@ -55,10 +57,12 @@ def make_box_forest(env: EnvLike | None = None, *, test_type: TestType = "fixed"
     >>> make_box_forest(view_bounds=(-10, 10, -10, 10), n_estimators=5).n_tests
     500
     """
-    if view_bounds is None and env is not None:
+    if env is not None and (view_bounds is None or isinstance(view_bounds, Mapping)):
         space = _spaces(env)[0]
         if not isinstance(space, gym.spaces.Box):
-            view_bounds = _view_bounds(space)
+            whole = _view_bounds(space)
+            view_bounds = whole if view_bounds is None else \
+                {**dict.fromkeys(_type_ids(space), whole), **view_bounds}
     # what the forest's constraints let through: True for an int, n_jobs=0 (joblib's error)
     n_estimators = _check_int("n_estimators", n_estimators, 1)
     n_tests = _check_int("n_tests", n_tests, 1)

@@ -176,8 +176,15 @@ def _object_bounds(space, view_bounds=None, n_types=None):
     if view_bounds is None:
         view_bounds = _view_bounds(space, min(box.shape[0] - 1, 2))
     if n_types is None:
-        if not np.isfinite(box.high[-1]):
+        n_types = len(_type_ids(space))
+        if not n_types:
             raise ValueError(f"the object rows of {space} have an unbounded type; give "
                              f"n_types")
-        n_types = int(box.high[-1]) + 1
     return view_bounds, n_types
+
+
+def _type_ids(space):
+    """The type ids of object-set observations, from the bound of their rows' last column:
+    ``range(n_types)``, empty when it is unbounded."""
+    high = _row_box(space).high[-1]
+    return range(int(high) + 1) if np.isfinite(high) else range(0)

@@ -184,6 +184,51 @@ def test_view_bounds_take_a_low_and_a_high_per_attribute():
         BoxExtraTreesRegressor(2, view_bounds=(-1, 1, -1, 1)).fit(X, y)
 
 
+def test_view_bounds_per_type_draw_each_types_tests_in_its_own_region():
+    rng = np.random.default_rng(4)
+    X, y = object_sets(rng, 300, 2, max_objects=20, extent=9.0), rng.normal(size=300)
+    forest = BoxExtraTreesRegressor(3, n_tests=50, min_samples_split=5, test_type="fixed",
+                                    test_width=1.0, relative_width=False, refine_tests=False,
+                                    view_bounds={0: 9.0, 1: (-2, 2, -1, 3), 7: 1.0},
+                                    random_state=0).fit(X, y)
+    # type 2 is not named: the training objects' bounding box; type 7 is absent: ignored
+    np.testing.assert_array_equal(forest.bounds_[:2], [[-9, 9, -9, 9], [-2, 2, -1, 3]])
+    assert forest.bounds_[2, 0] < -8.9 and forest.bounds_[2, 1] > 8.9
+    trees = [tree.tree_ for tree in forest.estimators_]
+    centres = {t: np.concatenate([tree.box[tree.object_type == t].reshape(-1, 2, 2).mean(axis=2)
+                                  for tree in trees]) for t in (0, 1, 2)}
+    assert all(len(c) > 10 for c in centres.values())
+    inside = (centres[1] >= [-2, -1]) & (centres[1] <= [2, 3])
+    assert inside.all()
+    assert np.abs(centres[0]).max() > 4 and np.abs(centres[2]).max() > 4
+    # one region for every type, as a dict or not, grows the same trees
+    whole = {t: 9.0 for t in range(3)}
+    a, b = (BoxExtraTreesRegressor(2, n_tests=20, view_bounds=v, random_state=1).fit(X, y)
+            for v in (9.0, whole))
+    for ta, tb in zip(a.estimators_, b.estimators_):
+        np.testing.assert_array_equal(ta.tree_.box, tb.tree_.box)
+    np.testing.assert_array_equal(a.predict(X), b.predict(X))
+    # it survives cloning and pickling
+    twin = pickle.loads(pickle.dumps(forest))
+    np.testing.assert_array_equal(twin.predict(X), forest.predict(X))
+
+
+@pytest.mark.parametrize("view_bounds, error, message", [
+    ({"wall": 2.0}, TypeError, "type ids \\(ints\\) as keys; got 'wall'"),
+    ({True: 2.0}, TypeError, "type ids \\(ints\\) as keys; got True"),
+    ({1: (2, -2, -1, 1)}, ValueError, "view_bounds\\[1\\] needs each low below its high"),
+    ({1: (-1, 1)}, ValueError, "view_bounds\\[1\\] must be \\(xmin, xmax, ymin, ymax\\)"),
+    ({1: np.nan}, ValueError, "view_bounds\\[1\\] must be"),
+])
+def test_view_bounds_per_type_are_checked(view_bounds, error, message):
+    rng = np.random.default_rng(5)
+    X, y = object_sets(rng, 20, 2), rng.normal(size=20)
+    with pytest.raises(error, match=message):
+        BoxExtraTreesRegressor(2, view_bounds=view_bounds).fit(X, y)
+    with pytest.raises(ValueError, match="mapping of type ids applies to object sets"):
+        BoxExtraTreesRegressor(2, view_bounds={0: 1.0}).fit(rng.normal(size=(20, 3)), y)
+
+
 def test_from_padded_keeps_the_masked_rows_in_order():
     padded = np.arange(2 * 3 * 4, dtype=float).reshape(2, 3, 4)
     padded[..., 3] = 1

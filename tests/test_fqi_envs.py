@@ -178,6 +178,14 @@ def test_a_forest_needs_only_the_view_square_a_grid_also_the_types():
     assert make_grid_ridge(AnyTypes, n_types=3)[0].n_types == 3
 
 
+def test_a_forest_takes_regions_for_some_types_and_the_view_for_the_others():
+    view = (-5.0, 5.0, -5.0, 5.0)
+    assert make_box_forest(Coins(), view_bounds={1: 2.0}).view_bounds == {0: view, 1: 2.0}
+    # unknown types: only the named ones (the others are drawn where their objects are)
+    assert make_box_forest(AnyTypes, view_bounds={1: 2.0}).view_bounds == {1: 2.0}
+    assert make_box_forest(view_bounds={1: 2.0}).view_bounds == {1: 2.0}
+
+
 class MovingCoins(Coins):
     """Coins seen as rows ``[x, y, vx, type]``: every object also has a velocity, here a
     distractor the forest has to do without."""

@@ -104,6 +104,7 @@ with tempfile.TemporaryDirectory() as folder:
 
 # The thesis's regressors, for an env observing object sets (built here from their bounds)
 assert_type(make_box_forest(view_bounds=(-10, 10, -10, 10)), BoxExtraTreesRegressor)
+assert_type(make_box_forest(view_bounds={1: 2.0, 3: (-4, 4, -2, 6)}), BoxExtraTreesRegressor)
 print(make_grid_ridge(view_bounds=(-10, 10, -10, 10), n_types=4)[0].n_bins)
 
 

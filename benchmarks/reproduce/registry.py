@@ -9,6 +9,8 @@ beside ours.
 """
 from dataclasses import dataclass, field, replace
 
+import envs
+
 from ..zoo_hyperparams import (ATARI_DQN, ATARI_PPO, HIGHWAY_DQN, HIGHWAY_PPO, SMALL_TASK_DQN,
                                ZOO_DQN, ZOO_PPO, ZOO_STEPS, without_gamma)
 from .budgets import BUDGETS
@@ -317,11 +319,21 @@ EXPERIMENTS = (
         {**_ALL_KEPT, "min_samples_split": 100},
         ("a forest per move", "keep_data_nmin/n_min=100"),
         {"move frame": {"move_frame": True},
-         "move frame, n_min=300": {"move_frame": True, "min_samples_split": 300}},
+         "move frame, n_min=300": {"move_frame": True, "min_samples_split": 300},
+         "move frame, K=1000": {"move_frame": True, "n_tests": 1000},
+         "move frame, gamma 0.8": {"move_frame": True, "gamma": 0.8},
+         "move frame, walls near (2)": {"move_frame": True,
+                                        "type_regions": ((envs.WALL, 2.0),)}},
         notes="fqi_frame's one forest on every transition of the run (up to 400,000, all of "
               "them in each fit) against the best kept-data setting, a forest per move with "
               "n_min=100; n_min=300 keeps the leaves of the four times larger data set about "
-              "as many as a forest per move has."),
+              "as many as a forest per move has; K=1000 and gamma 0.8 try more tests and a "
+              "longer horizon. Its greedy policy sometimes walks into a wall and, its state "
+              "unchanged, keeps walking into it for the rest of the episode: the forest "
+              "rarely draws a wall test where a wall blocks the move (a box's centre within "
+              "about half a unit of the path, 1 in 1,000 tests over the 20 x 20 view). "
+              "'walls near (2)' draws the wall tests' centres within 2 units of the agent, "
+              "the other types' over the whole view."),
     Experiment(
         "rmse_region", "extra", "RMSE with tests near the agent", "rmse", on_demand=True,
         defaults=_TUNED, settings={"whole view (10)": {}, **_NEAR},

@@ -11,6 +11,7 @@ from benchmarks.reproduce.kinds import KINDS
 from benchmarks.reproduce.registry import Experiment, resolve
 from benchmarks.reproduce.runner import plan
 from boxtrees import ObjectSets
+from envs import ENEMY, GRASS, MONEY, WALL
 
 from harness import TINY
 
@@ -127,7 +128,7 @@ def test_the_tuned_baselines_are_scored_once_per_fqi_iteration(name):
         budget.iterations] * 3
 
 
-def test_an_ablations_game_constants_ridge_penalty_and_test_region_reach_its_units():
+def test_an_ablations_game_constants_ridge_penalty_and_test_regions_reach_its_units():
     from benchmarks.reproduce.kinds._game import make_env, regressor
 
     def settings(experiment, label):
@@ -148,6 +149,14 @@ def test_an_ablations_game_constants_ridge_penalty_and_test_region_reach_its_uni
     assert regressor(whole, make_env(whole), TINY, 0).view_bounds == (-10.0, 10.0, -10.0, 10.0)
     with pytest.raises(ValueError, match="test_region"):
         dataclasses.replace(near, test_region=-1.0)
+    # walls' tests near the agent, the other types' over the whole view
+    walls = settings(REGISTRY["keep_data_frame"], "move frame, walls near (2)")
+    view = (-10.0, 10.0, -10.0, 10.0)
+    assert regressor(walls, make_env(walls), TINY, 0).view_bounds == {
+        MONEY: view, WALL: 2.0, GRASS: view, ENEMY: view}
+    for wrong in ({"type_regions": ((WALL, 0.0),)}, {"test_region": 4.0}):
+        with pytest.raises(ValueError, match="type_regions"):
+            dataclasses.replace(walls, **wrong)
 
 
 def test_a_move_frame_agent_fits_one_forest_on_every_move_turned_up():

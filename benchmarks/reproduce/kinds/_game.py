@@ -23,10 +23,10 @@ _MODELS = ("box", "grid")
 @dataclass(frozen=True)
 class ForestSettings(GameSettings):
     """A regressor of the thesis: a box forest (``model="box"``: ``test_type``,
-    ``test_width``, ``n_estimators``, ``n_tests``, ``min_samples_split``, and
-    ``test_region``, the half-side of the agent-centred square its tests are drawn in, None:
-    the whole view) or grid counts with a ridge (``model="grid"``: ``n_bins``,
-    ``alpha``)."""
+    ``test_width``, ``n_estimators``, ``n_tests``, ``min_samples_split``; ``test_region``,
+    the half-side of the agent-centred square its tests are drawn in, None: the whole view;
+    or ``type_regions``, ``(type id, half-side)`` pairs: such squares for some types only)
+    or grid counts with a ridge (``model="grid"``: ``n_bins``, ``alpha``)."""
 
     model: str = None
     test_type: str = None
@@ -35,6 +35,7 @@ class ForestSettings(GameSettings):
     n_tests: int = None
     min_samples_split: int = None
     test_region: float = None
+    type_regions: tuple = None
     n_bins: int = None
     alpha: float = 1.0
 
@@ -49,6 +50,12 @@ class ForestSettings(GameSettings):
         if self.test_region is not None and not (self.model == "box" and self.test_region > 0):
             raise ValueError(f"test_region must be a box model's positive half-side, got "
                              f"{self.test_region!r}")
+        if self.type_regions is not None and not (
+                self.model == "box" and self.test_region is None
+                and all(r > 0 for _, r in self.type_regions)):
+            raise ValueError(f"type_regions must be a box model's (type id, positive "
+                             f"half-side) pairs, without test_region; got "
+                             f"{self.type_regions!r}")
 
 
 @dataclass(frozen=True)
@@ -80,13 +87,16 @@ def regressor(settings, env, budget, seed):
     """The setting's regressor, with the budget's caps on M and K."""
     if settings.model == "grid":
         return make_grid_ridge(env, n_bins=settings.n_bins, alpha=settings.alpha)
+    view_bounds = (None if settings.test_region is None else (-settings.test_region,
+                                                              settings.test_region) * 2)
+    if settings.type_regions is not None:       # the other types: the whole view
+        view_bounds = {int(t): float(r) for t, r in settings.type_regions}
     return make_box_forest(
         env, test_type=settings.test_type, test_width=settings.test_width,
         n_estimators=_capped(settings.n_estimators, budget.max_trees),
         n_tests=_capped(settings.n_tests, budget.max_tests),
         min_samples_split=settings.min_samples_split, n_jobs=-1, random_state=seed,
-        view_bounds=None if settings.test_region is None else (-settings.test_region,
-                                                               settings.test_region) * 2)
+        view_bounds=view_bounds)
 
 
 def _capped(value, cap):
