@@ -323,7 +323,9 @@ EXPERIMENTS = (
          "move frame, K=1000": {"move_frame": True, "n_tests": 1000},
          "move frame, gamma 0.8": {"move_frame": True, "gamma": 0.8},
          "move frame, walls near (2)": {"move_frame": True,
-                                        "type_regions": ((envs.WALL, 2.0),)}},
+                                        "type_regions": ((envs.WALL, 2.0),)},
+         "move frame, walls near (2), gamma 0.8": {"move_frame": True, "gamma": 0.8,
+                                                   "type_regions": ((envs.WALL, 2.0),)}},
         notes="fqi_frame's one forest on every transition of the run (up to 400,000, all of "
               "them in each fit) against the best kept-data setting, a forest per move with "
               "n_min=100; n_min=300 keeps the leaves of the four times larger data set about "
@@ -333,7 +335,8 @@ EXPERIMENTS = (
               "rarely draws a wall test where a wall blocks the move (a box's centre within "
               "about half a unit of the path, 1 in 1,000 tests over the 20 x 20 view). "
               "'walls near (2)' draws the wall tests' centres within 2 units of the agent, "
-              "the other types' over the whole view."),
+              "the other types' over the whole view; with gamma 0.8 as well, the longer "
+              "horizon counts coins further away."),
     Experiment(
         "rmse_region", "extra", "RMSE with tests near the agent", "rmse", on_demand=True,
         defaults=_TUNED, settings={"whole view (10)": {}, **_NEAR},
