@@ -511,7 +511,8 @@ class _TrainingObjects:
 
     def _index_objects(self, estimator, sets, position):
         data, groups, n_types = sets.data, estimator.column_groups_, estimator.n_types_
-        edges = [_band_edges(estimator, *self._group_extent(g, n_types)) for g in range(len(groups))]
+        edges = [_band_edges(estimator, *self._group_extent(g, n_types))
+                 for g in range(len(groups))]
         n_bands = max(len(e) for e in edges) - 1
         # every group has n_bands bands; the last ones of a group with fewer are empty
         self.band_edges = np.array([np.pad(e, (0, n_bands + 1 - len(e)), constant_values=np.inf)
@@ -522,7 +523,6 @@ class _TrainingObjects:
         if (self.group_sizes > 2).any():   # their further columns are read in the rows
             self.attributes = np.ascontiguousarray(data[:, :estimator.n_attributes_])
             self.object_of = object_of
-
 
     def _group_extent(self, group, n_types):
         """The y extent that the regions of a column group's types span, ``(ymin, ymax)``, and
