@@ -308,12 +308,15 @@ EXPERIMENTS = (
         "fqi_frame", "extra", "One forest in the move's frame", "fqi", on_demand=True,
         defaults=_TUNED,
         settings={"a forest per move": {"same_as": "sampling/normal"},
-                  "move frame": {"move_frame": True}},
+                  "move frame": {"move_frame": True},
+                  "move frame, walls near (2)": {"move_frame": True,
+                                                 "type_regions": ((envs.WALL, 2.0),)}},
         notes="The game is symmetric under quarter turns, so Q(s, a) is Q(s', up) for s' the "
               "state turned so that move a points up (envs.move_frame). One forest of moving "
               "up then learns from the transitions of all four moves, each observation turned "
               "into its move's frame (FQI's action_input encoding): four times the data per "
-              "forest for about the same cost. New data every iteration, M=30, K=500."),
+              "forest for about the same cost. New data every iteration, M=30, K=500; with "
+              "the wall tests near the agent as in keep_data_frame."),
     _kept_variants(
         "keep_data_frame", "Keeping every transition, in the move's frame",
         {**_ALL_KEPT, "min_samples_split": 100},
