@@ -297,12 +297,14 @@ EXPERIMENTS = (
     Experiment(
         "fqi_region", "extra", "Tests near the agent: where the boxes are drawn", "fqi",
         on_demand=True, defaults=_TUNED,
-        settings={"whole view (10)": {"same_as": "sampling/normal"}, **_NEAR},
+        settings={"whole view (10)": {"same_as": "sampling/normal"}, **_NEAR,
+                  "walls near (2)": {"type_regions": ((envs.WALL, 2.0),)}},
         notes="The most used tests of a learned Q-forest sit within a few units of the agent "
               "(the attention figure), and at gamma 0.5 a coin 6 steps away is worth 3% of "
               "one at hand. Here the boxes' centres are drawn in an agent-centred square of "
               "half-side 6, 4 or 3 (36%, 16% or 9% of the view's area: each node's K=500 "
-              "tests that much denser there) against the whole 20 x 20 view; new data every "
+              "tests that much denser there) against the whole 20 x 20 view; or only the "
+              "wall tests' within 2 units (keep_data_frame's notes say why); new data every "
               "iteration, M=30, K=500."),
     Experiment(
         "fqi_frame", "extra", "One forest in the move's frame", "fqi", on_demand=True,
