@@ -34,6 +34,8 @@ _ALL_KEPT = {**_KEPT_DATA, "max_samples": 400_000}
 _KEPT_DATA_RUNS, _ALL_KEPT_RUNS = "keep_data/keep data (100k)", "keep_data_size/all (400k)"
 # Beyond the thesis: box centres drawn in an agent-centred square of these half-sides
 _NEAR = {f"near ({r})": {"test_region": float(r)} for r in (6, 4, 3)}
+# ... or only the wall tests' centres, within 2 units: where a wall blocks the next move
+_WALLS_NEAR = {"type_regions": ((envs.WALL, 2.0),)}
 _REPRESENTATIONS = {
     "fixed TW=1": {"test_type": "fixed", "test_width": 1.0},
     "bounded TW=4": {"test_type": "bounded", "test_width": 4.0},
@@ -298,7 +300,7 @@ EXPERIMENTS = (
         "fqi_region", "extra", "Tests near the agent: where the boxes are drawn", "fqi",
         on_demand=True, defaults=_TUNED,
         settings={"whole view (10)": {"same_as": "sampling/normal"}, **_NEAR,
-                  "walls near (2)": {"type_regions": ((envs.WALL, 2.0),)}},
+                  "walls near (2)": _WALLS_NEAR},
         notes="The most used tests of a learned Q-forest sit within a few units of the agent "
               "(the attention figure), and at gamma 0.5 a coin 6 steps away is worth 3% of "
               "one at hand. Here the boxes' centres are drawn in an agent-centred square of "
@@ -311,8 +313,7 @@ EXPERIMENTS = (
         defaults=_TUNED,
         settings={"a forest per move": {"same_as": "sampling/normal"},
                   "move frame": {"move_frame": True},
-                  "move frame, walls near (2)": {"move_frame": True,
-                                                 "type_regions": ((envs.WALL, 2.0),)}},
+                  "move frame, walls near (2)": {"move_frame": True, **_WALLS_NEAR}},
         notes="The game is symmetric under quarter turns, so Q(s, a) is Q(s', up) for s' the "
               "state turned so that move a points up (envs.move_frame). One forest of moving "
               "up then learns from the transitions of all four moves, each observation turned "
@@ -327,10 +328,9 @@ EXPERIMENTS = (
          "move frame, n_min=300": {"move_frame": True, "min_samples_split": 300},
          "move frame, K=1000": {"move_frame": True, "n_tests": 1000},
          "move frame, gamma 0.8": {"move_frame": True, "gamma": 0.8},
-         "move frame, walls near (2)": {"move_frame": True,
-                                        "type_regions": ((envs.WALL, 2.0),)},
+         "move frame, walls near (2)": {"move_frame": True, **_WALLS_NEAR},
          "move frame, walls near (2), gamma 0.8": {"move_frame": True, "gamma": 0.8,
-                                                   "type_regions": ((envs.WALL, 2.0),)}},
+                                                   **_WALLS_NEAR}},
         notes="fqi_frame's one forest on every transition of the run (up to 400,000, all of "
               "them in each fit) against the best kept-data setting, a forest per move with "
               "n_min=100; n_min=300 keeps the leaves of the four times larger data set about "

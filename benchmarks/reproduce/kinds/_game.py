@@ -87,9 +87,10 @@ def regressor(settings, env, budget, seed):
     """The setting's regressor, with the budget's caps on M and K."""
     if settings.model == "grid":
         return make_grid_ridge(env, n_bins=settings.n_bins, alpha=settings.alpha)
-    view_bounds = (None if settings.test_region is None else (-settings.test_region,
-                                                              settings.test_region) * 2)
-    if settings.type_regions is not None:       # the other types: the whole view
+    view_bounds = None          # the whole view
+    if settings.test_region is not None:
+        view_bounds = (-settings.test_region, settings.test_region) * 2
+    elif settings.type_regions is not None:     # the other types: the whole view
         view_bounds = {int(t): float(r) for t, r in settings.type_regions}
     return make_box_forest(
         env, test_type=settings.test_type, test_width=settings.test_width,
