@@ -330,7 +330,8 @@ EXPERIMENTS = (
          "move frame, gamma 0.8": {"move_frame": True, "gamma": 0.8},
          "move frame, walls near (2)": {"move_frame": True, **_WALLS_NEAR},
          **{f"move frame, walls near (2), gamma {g}": {"move_frame": True, "gamma": g,
-                                                       **_WALLS_NEAR} for g in (0.8, 0.9)}},
+                                                       **_WALLS_NEAR}
+            for g in (0.8, 0.9, 0.95, 0.99)}},
         notes="fqi_frame's one forest on every transition of the run (up to 400,000, all of "
               "them in each fit) against the best kept-data setting, a forest per move with "
               "n_min=100; n_min=300 keeps the leaves of the four times larger data set about "
@@ -340,7 +341,7 @@ EXPERIMENTS = (
               "rarely draws a wall test where a wall blocks the move (a box's centre within "
               "about half a unit of the path, 1 in 1,000 tests over the 20 x 20 view). "
               "'walls near (2)' draws the wall tests' centres within 2 units of the agent, "
-              "the other types' over the whole view; with gamma 0.8 or 0.9 as well, the "
+              "the other types' over the whole view; with gamma 0.8 to 0.99 as well, the "
               "longer horizon counts coins further away."),
     Experiment(
         "rmse_region", "extra", "RMSE with tests near the agent", "rmse", on_demand=True,
