@@ -7,7 +7,7 @@ from pathlib import Path
 from . import plots
 from .budgets import EVAL_REFERENCE_STEPS
 from .kinds import KINDS
-from .registry import EXPERIMENTS, REGISTRY
+from .registry import EXPERIMENTS, REGISTRY, resolve
 from .runner import gather, setting_units
 from .stats import last_window
 
@@ -47,11 +47,15 @@ def write_outputs(experiments, budget, out, seeds=None, elapsed=None, n_run=None
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     sections, summary, rows, measured = [], {}, [], {}
+    lent = {(owner.name, owner_label) for other in EXPERIMENTS if not other.on_demand
+            for owner, owner_label in (resolve(other, label) for label in other.settings)}
     for experiment in EXPERIMENTS:
         stats, runs = gather(experiment, budget, out, seeds)
         if experiment.on_demand and all("same_as" in experiment.settings[label]
-                                        for label in stats):
-            continue  # not run yet: only settings shared with (``same_as``) others have runs
+                                        or (experiment.name, label) in lent for label in stats):
+            # not run yet: only settings shared with (``same_as``) others have runs, or its
+            # own settings that a default experiment shares (and so ran)
+            continue
         planned = sum(len(setting_units(experiment, label, budget, out, seeds))
                       for label in experiment.settings)
         done = sum(s.n_runs for s in stats.values())

@@ -120,7 +120,8 @@ def test_baselines_share_their_owners_runs_and_read_against_the_ceiling(tiny_run
     out, _ = tiny_run
     baselines = REGISTRY["baselines"]
     owners = {resolve(baselines, label)[0].name for label in baselines.settings}
-    assert owners == {"representations", "keep_data", "baselines", "ceiling"}
+    assert owners == {"representations", "keep_data", "keep_data_frame", "baselines",
+                      "ceiling"}
     # one run of each reference policy, the budget's seeds for the rest
     assert len(runner.seeds_for(REGISTRY["ceiling"], BUDGETS["full"])) == 1
     stats, runs = gather(baselines, TINY, out)
