@@ -27,6 +27,8 @@ ACTION_NAMES = tuple(name.replace("_", " ") for name in envs.ACTION_NAMES)
 _REFERENCE_COLOURS = ("black", "dimgrey", "darkgrey", "silver")
 # curves whose last steps differ this many times are drawn on a log scale of steps
 _LOG_STEPS = 5
+# reward curves of more settings than this get a panel of their scores beside them
+_CROWDED = 5
 
 
 def save(fig, path):
@@ -44,23 +46,53 @@ def _title(experiment, budget, stats):
 
 def reward_curves(experiment, stats, budget):
     """Mean reward per iteration with a +-1 sd band over runs; iteration 0 is the random
-    policy (left out for the sword game, as in the thesis: it would dwarf the curves)."""
-    fig, ax = plt.subplots(figsize=(7.5, 4.5))
+    policy (left out for the sword game, as in the thesis: it would dwarf the curves). With
+    more than `_CROWDED` settings, whose curves overlap where they level off, a panel beside
+    them shows each setting's score (+-1 sd over runs) in its curve's colour, best on top."""
+    crowded = len(stats) > _CROWDED
+    fig, axes = plt.subplots(1, 1 + crowded, figsize=(7.5 + 4.5 * crowded, 4.5),
+                             squeeze=False, width_ratios=(7.5, 4.5)[:1 + crowded])
+    ax = axes[0, 0]
     first = 1 if experiment.env_id == "ObjectWorldSword-v0" else 0
+    colours = {}
     for label, s in stats.items():
         x = np.arange(first, len(s.curve_mean))
         mean, sd = s.curve_mean[first:], s.curve_sd[first:]
-        ax.plot(x, mean, marker="o", markersize=3, label=f"{label} ({s.score:,.0f})")
+        line, = ax.plot(x, mean, marker="o", markersize=3, label=f"{label} ({s.score:,.0f})")
+        colours[label] = line.get_color()
         ax.fill_between(x, mean - sd, mean + sd, alpha=0.2)
     ax.axhline(0, color="grey", lw=0.6)
     ax.set_xlabel("iteration (0: random policy)" if first == 0 else "iteration")
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("reward per 20,000 greedy steps")
-    ax.set_title(_title(experiment, budget, stats), fontsize=10)
-    ax.legend(fontsize=8, title=f"setting (mean of last {last_window(budget)} it.)",
-              title_fontsize=8)
+    window = last_window(budget)
+    ax.legend(fontsize=8, title=f"setting (mean of last {window} it.)", title_fontsize=8)
     ax.grid(alpha=0.3)
+    if crowded:
+        _score_panel(axes[0, 1], stats, colours, window)
+        fig.suptitle(_title(experiment, budget, stats), fontsize=10)
+    else:
+        ax.set_title(_title(experiment, budget, stats), fontsize=10)
     return fig
+
+
+def _score_panel(ax, stats, colours, window):
+    """Each setting's score +-1 sd over runs as a dot on its own row, best on top, in the
+    colour of its curve (`colours`: label -> colour)."""
+    labels = sorted(stats, key=lambda label: stats[label].score)
+    for row, label in enumerate(labels):
+        s = stats[label]
+        ax.errorbar(s.score, row, xerr=s.score_sd if s.n_runs > 1 else None, fmt="o",
+                    color=colours[label], capsize=3)
+    runs = {label: stats[label].n_runs for label in labels}
+    ax.set_yticks(range(len(labels)), [f"{label} ({runs[label]} run{'s' * (runs[label] > 1)})"
+                                       for label in labels], fontsize=7)
+    ax.yaxis.tick_right()
+    ax.set_xlabel(f"mean of the last {window} iterations (+-1 sd over runs)", fontsize=8)
+    ax.xaxis.set_major_locator(MaxNLocator(4))
+    ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
+    ax.tick_params(axis="x", labelsize=7)
+    ax.grid(axis="x", alpha=0.3)
 
 
 def rmse_bars(experiment, stats, runs, budget):

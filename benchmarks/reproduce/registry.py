@@ -333,7 +333,11 @@ EXPERIMENTS = (
          "move frame, walls near (2)": {"move_frame": True, **_WALLS_NEAR},
          **{f"move frame, walls near (2), gamma {g}": {"move_frame": True, "gamma": g,
                                                        **_WALLS_NEAR}
-            for g in (0.8, 0.9, 0.95, 0.99)}},
+            for g in (0.8, 0.9, 0.95, 0.99)},
+         "move frame, walls near (2), gamma 0.9, n_min=50": {
+             "move_frame": True, "gamma": 0.9, "min_samples_split": 50, **_WALLS_NEAR},
+         "move frame, walls near (2), gamma 0.9, epsilon to 0.05": {
+             "move_frame": True, "gamma": 0.9, "final_epsilon": 0.05, **_WALLS_NEAR}},
         notes="fqi_frame's one forest on every transition of the run (up to 400,000, all of "
               "them in each fit) against the best kept-data setting, a forest per move with "
               "n_min=100; n_min=300 keeps the leaves of the four times larger data set about "
@@ -344,7 +348,9 @@ EXPERIMENTS = (
               "about half a unit of the path, 1 in 1,000 tests over the 20 x 20 view). "
               "'walls near (2)' draws the wall tests' centres within 2 units of the agent, "
               "the other types' over the whole view; with gamma 0.8 to 0.99 as well, the "
-              "longer horizon counts coins further away."),
+              "longer horizon counts coins further away. At gamma 0.9, n_min=50 tries "
+              "smaller leaves, and epsilon falling linearly from 0.2 to 0.05 over the run "
+              "data nearer the greedy policy's."),
     Experiment(
         "rmse_region", "extra", "RMSE with tests near the agent", "rmse", on_demand=True,
         defaults=_TUNED, settings={"whole view (10)": {}, **_NEAR},

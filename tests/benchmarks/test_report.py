@@ -60,6 +60,34 @@ def test_versus_steps_zero_line_only_in_range_and_legend_below(offset, zero_line
     plots.plt.close(fig)
 
 
+@pytest.mark.parametrize("n_settings", [5, 6])
+def test_crowded_reward_curves_get_a_score_panel_best_on_top(n_settings):
+    """Beyond five settings the curves' plateaus overlap: a panel beside them shows each
+    score +-1 sd in its curve's colour, one row per setting, the best on the top row."""
+    scores = [3.0, 9.0, 1.0, 7.0, 5.0, 8.0][:n_settings]
+    stats = {f"s{i}": SimpleNamespace(curve_mean=np.array([-9.0, score / 2, score]),
+                                      curve_sd=np.ones(3), score=score, score_sd=0.5,
+                                      n_runs=1 + i % 2)
+             for i, score in enumerate(scores)}
+    fig = plots.reward_curves(REGISTRY["fqi_TW"], stats, TINY)
+    assert len(fig.axes) == 1 + (n_settings > 5)
+    if n_settings > 5:
+        curves, panel = fig.axes
+        colours = {line.get_label().split(" (")[0]: line.get_color()
+                   for line in curves.get_lines() if line.get_label().startswith("s")}
+        labels = [tick.get_text() for tick in panel.get_yticklabels()]
+        order = sorted(stats, key=lambda label: stats[label].score)
+        assert labels == [f"{label} ({stats[label].n_runs} run"
+                          f"{'s' * (stats[label].n_runs > 1)})" for label in order]
+        # one errorbar per row, bottom to top
+        for row, (container, label) in enumerate(zip(panel.containers, order, strict=True)):
+            (x,), (y,) = container.lines[0].get_data()
+            assert (x, y) == (stats[label].score, row)
+            assert to_rgb(container.lines[0].get_color()) == to_rgb(colours[label])
+            assert container.has_xerr == (stats[label].n_runs > 1)
+    plots.plt.close(fig)
+
+
 def test_report_shows_thesis_numbers_beside_ours_and_computed_verdicts(tmp_path):
     experiment = REGISTRY["sampling"]
     budget = replace(TINY, iterations=3)

@@ -63,13 +63,15 @@ class AgentSettings(ForestSettings):
     """An FQI agent of the thesis's protocol with its regressor: ``gamma``, collections
     every ``resample_every`` iterations, ``keep_data`` up to ``max_samples`` transitions
     (default: one iteration's), and with ``move_frame`` one regressor of every move seen in
-    its own frame (`envs.in_move_frame`) instead of one per move."""
+    its own frame (`envs.in_move_frame`) instead of one per move. Exploration falls linearly
+    over the run from the thesis's epsilon to ``final_epsilon`` (by default it stays)."""
 
     gamma: float = GAMMA
     resample_every: int = 1
     keep_data: bool = False
     max_samples: int = None
     move_frame: bool = False
+    final_epsilon: float = THESIS_EPSILON
 
 
 def make_env(settings, **kwargs):
@@ -107,7 +109,7 @@ def _capped(value, cap):
 def make_agent(settings, budget, seed, samples):
     """The FQI agent of a registry setting on the game, with the thesis's protocol: up to
     400 training worlds in lockstep (the game's batched engine, through its vector entry
-    point), epsilon 0.2, greedy ties to the first action, the actions' Q-functions
+    point), epsilon 0.2 (or falling to ``settings.final_epsilon``), greedy ties to the first action, the actions' Q-functions
     predicted side by side (``n_jobs=-1``), evaluated on the reference worlds after every
     iteration; learn it with ``learn(n_iterations=...)``.
 
@@ -133,7 +135,8 @@ def make_agent(settings, budget, seed, samples):
                samples_per_iteration=samples, resample_every=settings.resample_every,
                keep_data=settings.keep_data,
                max_samples=max(settings.max_samples or samples, samples),
-               exploration_initial_eps=THESIS_EPSILON, exploration_final_eps=THESIS_EPSILON,
+               exploration_initial_eps=THESIS_EPSILON,
+               exploration_final_eps=settings.final_epsilon, exploration_fraction=1.0,
                action_input=envs.in_move_frame if settings.move_frame else False,
                tie_break="first", n_envs=min(400, samples), n_jobs=-1,
                eval_seeds=reference_seeds(env, budget), seed=seed)
