@@ -180,6 +180,21 @@ def test_a_move_frame_agent_fits_one_forest_on_every_move_turned_up():
         make_agent(sword, TINY, 0, 200)
 
 
+@pytest.mark.parametrize("label, final", [("move frame, walls near (2), gamma 0.9", 0.2),
+                                          ("move frame, walls near (2), gamma 0.9, "
+                                           "epsilon to 0.05", 0.05)])
+def test_game_agents_explore_with_the_thesis_epsilon_or_fall_linearly_to_the_final(label, final):
+    from benchmarks.reproduce.kinds._game import THESIS_EPSILON, make_agent
+
+    settings = KINDS["fqi"].settings(REGISTRY["keep_data_frame"].params(label))
+    agent = make_agent(settings, TINY, 0, 100)
+    rates = []
+    agent.learn(n_iterations=4, callback=lambda *_: rates.append(agent.exploration_rate))
+    # the first round is random play (no Q-function yet) whatever the rate
+    assert rates == pytest.approx([THESIS_EPSILON + (final - THESIS_EPSILON) * i / 4
+                                   for i in range(4)])
+
+
 def test_the_reference_worlds_are_seeds_fqi_never_trains_on():
     """The two packages cannot import each other; the harness joins them on one boundary."""
     import envs
