@@ -315,13 +315,17 @@ EXPERIMENTS = (
                   "move frame": {"move_frame": True},
                   "move frame, walls near (2)": {"move_frame": True, **_WALLS_NEAR},
                   "move frame, walls near (2), gamma 0.9": {"move_frame": True, "gamma": 0.9,
-                                                            **_WALLS_NEAR}},
+                                                            **_WALLS_NEAR},
+                  "move frame, walls near (2), gamma 0.9, epsilon to 0.05": {
+                      "move_frame": True, "gamma": 0.9, "final_epsilon": 0.05,
+                      **_WALLS_NEAR}},
         notes="The game is symmetric under quarter turns, so Q(s, a) is Q(s', up) for s' the "
               "state turned so that move a points up (envs.move_frame). One forest of moving "
               "up then learns from the transitions of all four moves, each observation turned "
               "into its move's frame (FQI's action_input encoding): four times the data per "
               "forest for about the same cost. New data every iteration, M=30, K=500; with "
-              "the wall tests near the agent as in keep_data_frame, and with its gamma 0.9."),
+              "the wall tests near the agent as in keep_data_frame, and with its gamma 0.9 "
+              "(and epsilon falling from 0.2 to 0.05 over the run)."),
     _kept_variants(
         "keep_data_frame", "Keeping every transition, in the move's frame",
         {**_ALL_KEPT, "min_samples_split": 100},
