@@ -625,9 +625,10 @@ _REFERENCE_NOTES = ("An upper reference, not a learner: the planner (envs.Lookah
                     "as every learner.")
 _FQI_BOX, _FQI_KEEP = "box FQI, fixed TW=1", "box FQI, keeping data (100k)"
 # ... and the best learner measured (keep_data_frame: every transition, the move's frame,
-# the wall tests near the agent, gamma 0.9)
-_FQI_BEST, _FQI_BEST_RUNS = ("box FQI, move frame, walls near, gamma 0.9 (all kept)",
-                             "keep_data_frame/move frame, walls near (2), gamma 0.9")
+# the wall tests near the agent, gamma 0.9, epsilon falling to 0.05)
+_FQI_BEST, _FQI_BEST_RUNS = (
+    "box FQI, move frame, walls near, gamma 0.9, epsilon to 0.05 (all kept)",
+    "keep_data_frame/move frame, walls near (2), gamma 0.9, epsilon to 0.05")
 _TUNED_BASELINES = {  # the best configuration of each finished search (its table: the report)
     "PPO on the objects (tuned)": {
         "algo": "PPO", "observation": "objects",
