@@ -354,7 +354,7 @@ EXPERIMENTS = (
               "the other types' over the whole view; with gamma 0.8 to 0.99 as well, the "
               "longer horizon counts coins further away. At gamma 0.9, n_min=50 tries "
               "smaller leaves, and epsilon falling linearly from 0.2 to 0.05 over the run "
-              "data nearer the greedy policy's."),
+              "collects data nearer the greedy policy's."),
     Experiment(
         "rmse_region", "extra", "RMSE with tests near the agent", "rmse", on_demand=True,
         defaults=_TUNED, settings={"whole view (10)": {}, **_NEAR},

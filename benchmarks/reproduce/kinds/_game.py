@@ -109,9 +109,10 @@ def _capped(value, cap):
 def make_agent(settings, budget, seed, samples):
     """The FQI agent of a registry setting on the game, with the thesis's protocol: up to
     400 training worlds in lockstep (the game's batched engine, through its vector entry
-    point), epsilon 0.2 (or falling to ``settings.final_epsilon``), greedy ties to the first action, the actions' Q-functions
-    predicted side by side (``n_jobs=-1``), evaluated on the reference worlds after every
-    iteration; learn it with ``learn(n_iterations=...)``.
+    point), epsilon 0.2 (or falling linearly to ``settings.final_epsilon`` over the run),
+    greedy ties to the first action, the actions' Q-functions predicted side by side
+    (``n_jobs=-1``), evaluated on the reference worlds after every iteration; learn it with
+    ``learn(n_iterations=...)``.
 
     Parameters
     ----------
