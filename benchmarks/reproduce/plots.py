@@ -53,6 +53,8 @@ def reward_curves(experiment, stats, budget):
     fig, axes = plt.subplots(1, 1 + crowded, figsize=(7.5 + 4.5 * crowded, 4.5),
                              squeeze=False, width_ratios=(7.5, 4.5)[:1 + crowded])
     ax = axes[0, 0]
+    if len(stats) > len(plt.rcParams["axes.prop_cycle"].by_key()["color"]):
+        ax.set_prop_cycle(color=plt.get_cmap("tab20").colors)  # no colour twice
     first = 1 if experiment.env_id == "ObjectWorldSword-v0" else 0
     colours = {}
     for label, s in stats.items():
@@ -66,7 +68,12 @@ def reward_curves(experiment, stats, budget):
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("reward per 20,000 greedy steps")
     window = last_window(budget)
-    ax.legend(fontsize=8, title=f"setting (mean of last {window} it.)", title_fontsize=8)
+    title = f"setting (mean of last {window} it.)"
+    if crowded:  # below the axes, off the curves
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2,
+                  title=title, title_fontsize=7)
+    else:
+        ax.legend(fontsize=8, title=title, title_fontsize=8)
     ax.grid(alpha=0.3)
     if crowded:
         _score_panel(axes[0, 1], stats, colours, window)

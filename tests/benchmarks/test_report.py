@@ -60,11 +60,12 @@ def test_versus_steps_zero_line_only_in_range_and_legend_below(offset, zero_line
     plots.plt.close(fig)
 
 
-@pytest.mark.parametrize("n_settings", [5, 6])
+@pytest.mark.parametrize("n_settings", [5, 6, 12])
 def test_crowded_reward_curves_get_a_score_panel_best_on_top(n_settings):
     """Beyond five settings the curves' plateaus overlap: a panel beside them shows each
-    score +-1 sd in its curve's colour, one row per setting, the best on the top row."""
-    scores = [3.0, 9.0, 1.0, 7.0, 5.0, 8.0][:n_settings]
+    score +-1 sd in its curve's colour, one row per setting, the best on the top row; no
+    two curves share a colour."""
+    scores = [3.0, 9.0, 1.0, 7.0, 5.0, 8.0, 2.0, 4.0, 6.0, 10.0, 12.0, 11.0][:n_settings]
     stats = {f"s{i}": SimpleNamespace(curve_mean=np.array([-9.0, score / 2, score]),
                                       curve_sd=np.ones(3), score=score, score_sd=0.5,
                                       n_runs=1 + i % 2)
@@ -75,6 +76,7 @@ def test_crowded_reward_curves_get_a_score_panel_best_on_top(n_settings):
         curves, panel = fig.axes
         colours = {line.get_label().split(" (")[0]: line.get_color()
                    for line in curves.get_lines() if line.get_label().startswith("s")}
+        assert len({to_rgb(colour) for colour in colours.values()}) == n_settings
         labels = [tick.get_text() for tick in panel.get_yticklabels()]
         order = sorted(stats, key=lambda label: stats[label].score)
         assert labels == [f"{label} ({stats[label].n_runs} run"
