@@ -69,9 +69,8 @@ def reward_curves(experiment, stats, budget):
     ax.set_ylabel("reward per 20,000 greedy steps")
     window = last_window(budget)
     title = f"setting (mean of last {window} it.)"
-    if crowded:  # below the axes, off the curves
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2,
-                  title=title, title_fontsize=7)
+    if crowded:
+        _legend_below(ax, title, ncols=2)
     else:
         ax.legend(fontsize=8, title=title, title_fontsize=8)
     ax.grid(alpha=0.3)
@@ -81,6 +80,12 @@ def reward_curves(experiment, stats, budget):
     else:
         ax.set_title(_title(experiment, budget, stats), fontsize=10)
     return fig
+
+
+def _legend_below(ax, title, ncols=1):
+    """`ax`'s legend under it, where many entries do not hide the curves."""
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=ncols,
+              title=title, title_fontsize=7)
 
 
 def _score_panel(ax, stats, colours, window):
@@ -182,9 +187,7 @@ def versus_steps(experiment, stats, curves, budget, ylabel="reward per 20,000 gr
     ax.yaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
     ax.set_ylabel(ylabel)
     ax.set_title(_title(experiment, budget, stats), fontsize=10)
-    # below the axes: with many settings a legend inside would hide the curves
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14),
-              title="method (final score, wall time)", title_fontsize=7)
+    _legend_below(ax, "method (final score, wall time)")
     ax.grid(alpha=0.3)
     return fig
 

@@ -36,6 +36,8 @@ _KEPT_DATA_RUNS, _ALL_KEPT_RUNS = "keep_data/keep data (100k)", "keep_data_size/
 _NEAR = {f"near ({r})": {"test_region": float(r)} for r in (6, 4, 3)}
 # ... or only the wall tests' centres, within 2 units: where a wall blocks the next move
 _WALLS_NEAR = {"type_regions": ((envs.WALL, 2.0),)}
+# ... with one forest of every move, seen in its own frame (fqi_frame, keep_data_frame)
+_FRAME_WALLS_NEAR = {"move_frame": True, **_WALLS_NEAR}
 _REPRESENTATIONS = {
     "fixed TW=1": {"test_type": "fixed", "test_width": 1.0},
     "bounded TW=4": {"test_type": "bounded", "test_width": 4.0},
@@ -313,12 +315,10 @@ EXPERIMENTS = (
         defaults=_TUNED,
         settings={"a forest per move": {"same_as": "sampling/normal"},
                   "move frame": {"move_frame": True},
-                  "move frame, walls near (2)": {"move_frame": True, **_WALLS_NEAR},
-                  "move frame, walls near (2), gamma 0.9": {"move_frame": True, "gamma": 0.9,
-                                                            **_WALLS_NEAR},
+                  "move frame, walls near (2)": _FRAME_WALLS_NEAR,
+                  "move frame, walls near (2), gamma 0.9": {**_FRAME_WALLS_NEAR, "gamma": 0.9},
                   "move frame, walls near (2), gamma 0.9, epsilon to 0.05": {
-                      "move_frame": True, "gamma": 0.9, "final_epsilon": 0.05,
-                      **_WALLS_NEAR}},
+                      **_FRAME_WALLS_NEAR, "gamma": 0.9, "final_epsilon": 0.05}},
         notes="The game is symmetric under quarter turns, so Q(s, a) is Q(s', up) for s' the "
               "state turned so that move a points up (envs.move_frame). One forest of moving "
               "up then learns from the transitions of all four moves, each observation turned "
@@ -334,14 +334,13 @@ EXPERIMENTS = (
          "move frame, n_min=300": {"move_frame": True, "min_samples_split": 300},
          "move frame, K=1000": {"move_frame": True, "n_tests": 1000},
          "move frame, gamma 0.8": {"move_frame": True, "gamma": 0.8},
-         "move frame, walls near (2)": {"move_frame": True, **_WALLS_NEAR},
-         **{f"move frame, walls near (2), gamma {g}": {"move_frame": True, "gamma": g,
-                                                       **_WALLS_NEAR}
+         "move frame, walls near (2)": _FRAME_WALLS_NEAR,
+         **{f"move frame, walls near (2), gamma {g}": {**_FRAME_WALLS_NEAR, "gamma": g}
             for g in (0.8, 0.9, 0.95, 0.99)},
          "move frame, walls near (2), gamma 0.9, n_min=50": {
-             "move_frame": True, "gamma": 0.9, "min_samples_split": 50, **_WALLS_NEAR},
+             **_FRAME_WALLS_NEAR, "gamma": 0.9, "min_samples_split": 50},
          "move frame, walls near (2), gamma 0.9, epsilon to 0.05": {
-             "move_frame": True, "gamma": 0.9, "final_epsilon": 0.05, **_WALLS_NEAR}},
+             **_FRAME_WALLS_NEAR, "gamma": 0.9, "final_epsilon": 0.05}},
         notes="fqi_frame's one forest on every transition of the run (up to 400,000, all of "
               "them in each fit) against the best kept-data setting, a forest per move with "
               "n_min=100; n_min=300 keeps the leaves of the four times larger data set about "
