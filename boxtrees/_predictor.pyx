@@ -12,26 +12,36 @@ only the sample's objects of the tested type, attribute by attribute; they re-va
 of use, the rows and offsets they read (a batch may have changed since it was checked), and
 report the first bad row instead of reading past an array. Samples are processed in blocks,
 tree by tree, so that a tree's nodes stay in cache across a block. The walk itself is a kernel
-of ``_simd.h``: with AVX-512 it walks two samples side by side, and tests up to 16 of a
-sample's objects at once.
+of ``_simd.h``: with AVX-512 it walks two samples side by side, tests up to 16 of a
+sample's objects at once, and tests a chain of up to 16 nodes that mostly send samples left
+(`_chains`) at once.
 """
 import numpy as np
 
 cimport numpy as cnp
 from libc.math cimport INFINITY
+from libc.stdint cimport INT32_MAX
 
 from ._layout import EXTRA_DTYPE, MAX_ATTRIBUTES, NODE_DTYPE
 
 from ._simd cimport boxtrees_kernels, boxtrees_select_kernels
-from ._tree cimport MAX_TYPE, TREE_LEAF, boxtrees_extra, boxtrees_node
+from ._tree cimport (
+    BOXTREES_CHAIN_LANES, MAX_TYPE, TREE_LEAF, boxtrees_chain, boxtrees_extra, boxtrees_node,
+)
 from ._utils cimport (
-    BAD_OFFSETS, ROW_OK, ROW_TYPE_TOO_LARGE, coord_t, float64_t, intp_t, row_problem,
+    BAD_OFFSETS, ROW_OK, ROW_TYPE_TOO_LARGE, coord_t, float64_t, int32, intp_t, row_problem,
 )
 
 cnp.import_array()
 
 cdef enum:
     BLOCK = 64
+    RIGHT_SHARE = 4  # a chain's nodes sent at most 1 / RIGHT_SHARE of their samples right
+# a chain is kept if a walk is expected to pass this many of its nodes, and walked as one by
+# samples of at most OBJECTS_PER_LANE objects per node passed (its cost grows with the
+# objects, a step's barely)
+cdef double MIN_LANES = 6.0
+cdef double OBJECTS_PER_LANE = 2.0
 
 # the traversal kernel (see _simd.h)
 cdef boxtrees_kernels _kernels = boxtrees_select_kernels(16)
@@ -60,6 +70,7 @@ def _set_simd(int max_lanes=16):
 cdef struct ForestView:
     const boxtrees_node* nodes
     const boxtrees_extra* extras
+    const boxtrees_chain* chains
     const float64_t* value       # n_outputs per node (the prediction at leaves)
     const intp_t* tree_offsets   # first node of each tree
     intp_t n_trees
@@ -89,6 +100,15 @@ def _tree_arrays(k, tree):
     return arrays
 
 
+def _node_samples(tree, n_nodes):
+    """A tree's ``n_node_samples`` (the training samples that reached each node), as intp;
+    -1 for every node where the tree has none of the right shape (they only guide speed)."""
+    counts = np.asarray(getattr(tree, "n_node_samples", ()))
+    if counts.shape != (n_nodes,) or counts.dtype.kind not in "iu":
+        return np.full(n_nodes, -1, dtype=np.intp)
+    return np.clip(counts.astype(np.float64), -1, _INT32.max).astype(np.intp)
+
+
 cdef class PackedForest:
     """The nodes of several trees as one private array of `NODE_DTYPE` records, plus leaf
     values, validated once when built.
@@ -116,12 +136,14 @@ cdef class PackedForest:
     cdef readonly intp_t n_outputs
     cdef readonly intp_t n_types
     cdef readonly intp_t n_attributes
+    cdef readonly intp_t n_chains   # left chains walked as one by the AVX-512 kernel
     cdef bint _dense            # types are 0 .. n_types - 1: an id is its own position
 
     def __init__(self, trees, types):
         types = np.array(types, dtype=np.intp).ravel()
         if types.size == 0 or types[0] < 0 or (np.diff(types) <= 0).any():
             raise ValueError("types must be sorted, distinct, non-negative type ids")
+        trees = list(trees)
         per_tree = [_tree_arrays(k, tree) for k, tree in enumerate(trees)]
         if not per_tree:
             raise ValueError("a forest needs at least one tree")
@@ -198,9 +220,18 @@ cdef class PackedForest:
         extras["low"][slot] = box[more[node_of], column, 0]
         extras["high"][slot] = box[more[node_of], column, 1]
         value = np.ascontiguousarray(cat["value"], dtype=np.float64)
-        self._arrays = (nodes, extras, value, offsets, types)
+        marks = np.empty(n_nodes, dtype=np.int32)
+        n_samples = np.concatenate([_node_samples(tree, len(a["value"]))
+                                    for tree, a in zip(trees, per_tree)])
+        self.n_chains = _chains(<boxtrees_node*>cnp.PyArray_DATA(nodes), offsets, n_samples,
+                                NULL, <int32*>cnp.PyArray_DATA(marks))
+        chains = np.zeros(max(self.n_chains, 1) * sizeof(boxtrees_chain), dtype=np.uint8)
+        _chains(<boxtrees_node*>cnp.PyArray_DATA(nodes), offsets, n_samples,
+                <boxtrees_chain*>cnp.PyArray_DATA(chains), <int32*>cnp.PyArray_DATA(marks))
+        self._arrays = (nodes, extras, value, offsets, types, chains)
         self._view.nodes = <const boxtrees_node*>cnp.PyArray_DATA(nodes)
         self._view.extras = <const boxtrees_extra*>cnp.PyArray_DATA(extras)
+        self._view.chains = <const boxtrees_chain*>cnp.PyArray_DATA(chains)
         self._view.value = <const float64_t*>cnp.PyArray_DATA(value)
         self._view.tree_offsets = <const intp_t*>cnp.PyArray_DATA(offsets)
         self._view.n_trees = self.n_trees = len(counts)
@@ -267,7 +298,13 @@ cdef class PackedForest:
             return problem, row
         features_arr = np.zeros((n_attributes, pos), dtype=np.float32)
         cdef coord_t[:, ::1] features = features_arr
+        positions_arr = np.empty(pos, dtype=np.int32)    # each object's type position
+        cdef int32[::1] positions = positions_arr
         with nogil:
+            for i in range(n_sets):
+                for d in range(self.n_types):
+                    for k in range(type_ptr[i, d], type_ptr[i, d + 1]):
+                        positions[k] = <int32>d
             # the rows are read again: every index is re-checked where it is used, so rows
             # changed in between cannot move a write out of its sample's range
             for i in range(n_sets):
@@ -282,17 +319,89 @@ cdef class PackedForest:
                             features[c, cursor[d]] = data[k, c]
                         cursor[d] += 1
             _walk(&self._view, &features[0, 0] if pos else &_NO_OBJECT, pos,
-                  &type_ptr[0, 0] if n_sets > 0 else NULL, stride, n_sets, mean, leaves)
+                  &positions[0] if pos else NULL, &type_ptr[0, 0] if n_sets > 0 else NULL,
+                  stride, n_sets, mean, leaves)
         return ROW_OK, -1
 
 
+cdef intp_t _chains(boxtrees_node* nodes, const intp_t[::1] offsets,
+                    const intp_t[::1] n_samples, boxtrees_chain* chains,
+                    int32* marks) noexcept nogil:
+    """Cut every tree's left chains (`boxtrees_chain`) and keep those worth walking as one:
+    with ``chains`` NULL, mark in ``marks`` the first node of each kept chain (1; every
+    other node -1) and return how many; then, with room for them in ``chains``, fill their
+    records and point their first nodes to them (``extra = -2 - chain``).
+
+    A chain runs over consecutive inner nodes, each the left child of the one before, whose
+    boxes bound the same two attributes and no others, up to ``BOXTREES_CHAIN_LANES`` of them
+    (the validated children keep its nodes in their own tree). It takes only nodes that sent
+    at most one in ``RIGHT_SHARE`` of their training samples (``n_samples``, -1 where
+    unknown) right, and is kept if a walk is expected to pass ``MIN_LANES`` of its nodes or
+    more: a walk tests a chain's nodes all at once, which pays where it mostly goes left, as
+    down the long unbalanced spines of box tests that each split off a few samples. Which
+    nodes form chains changes the speed of a walk, never where it ends.
+    """
+    cdef bint filling = chains != NULL, heavy
+    cdef intp_t tree, i, j, o, lanes, first = -1, n_kept = 0
+    cdef boxtrees_node* node
+    cdef boxtrees_chain* c = NULL
+    cdef double reach = 0.0, lanes_passed = 0.0   # of the open chain: P(reaching the next lane)
+    for tree in range(offsets.shape[0] - 1):
+        o = offsets[tree]
+        lanes = 0                  # of the open chain (first: its first node), 0: none
+        for i in range(offsets[tree + 1] - o + 1):
+            node = nodes + o + i
+            heavy = (i < offsets[tree + 1] - o and node.left != TREE_LEAF and node.extra < 0
+                     and n_samples[o + i] > 0
+                     and 0 <= n_samples[o + node.right] <= n_samples[o + i] // RIGHT_SHARE)
+            if heavy and 0 < lanes < BOXTREES_CHAIN_LANES and (node - 1).left == i \
+                    and (node - 1).x_column == node.x_column \
+                    and (node - 1).y_column == node.y_column:
+                lanes += 1                                  # the open chain goes on
+            else:
+                if lanes and not filling:                   # close the open chain
+                    marks[first] = 1 if lanes_passed >= MIN_LANES else -1
+                    n_kept += marks[first] == 1
+                if i == offsets[tree + 1] - o:
+                    break
+                if not filling:
+                    marks[o + i] = -1
+                lanes, first = 0, o + i
+                c = NULL
+                if heavy:                                   # open a chain here
+                    lanes, reach, lanes_passed = 1, 1.0, 0.0
+                    if filling and marks[first] == 1:
+                        node.extra = <int32>(-2 - n_kept)
+                        c = chains + n_kept
+                        n_kept += 1
+                        c.first, c.n = <int32>i, 0
+                        c.x_column, c.y_column = node.x_column, node.y_column
+                        for j in range(BOXTREES_CHAIN_LANES):
+                            c.type[j], c.threshold[j] = -1, INT32_MAX
+            if not lanes:
+                continue
+            if not filling:
+                marks[o + i] = -1 if lanes > 1 else 0
+            lanes_passed += reach
+            reach *= 1.0 - <double>n_samples[o + node.right] / n_samples[o + i]
+            if c != NULL:
+                c.x0[c.n], c.x1[c.n] = node.box[0], node.box[1]
+                c.y0[c.n], c.y1[c.n] = node.box[2], node.box[3]
+                c.type[c.n], c.threshold[c.n] = node.object_type, node.threshold
+                c.max_objects = <int32>(OBJECTS_PER_LANE * lanes_passed)
+                c.n += 1
+    return n_kept
+
+
 cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_objects,
-                const intp_t* type_ptr, intp_t stride, intp_t n_samples, float64_t* mean,
-                intp_t* leaves) noexcept nogil:
+                const int32* positions, const intp_t* type_ptr, intp_t stride,
+                intp_t n_samples, float64_t* mean, intp_t* leaves) noexcept nogil:
     """Walk every sample through every tree, in blocks, tree by tree.
 
     Attribute ``c`` of sample ``i``'s objects of type position ``d`` is ``features[c *
-    n_objects + type_ptr[i * stride + d]:c * n_objects + type_ptr[i * stride + d + 1]]``. Writes the mean leaf value per sample into ``mean`` or,
+    n_objects + type_ptr[i * stride + d]:c * n_objects + type_ptr[i * stride + d + 1]]``, and
+    ``positions[k]`` is the type position of object ``k``. Writes the mean leaf value per
+    sample into ``mean`` or,
     when ``mean`` is NULL, the tree-local leaf ids into the (n_samples, n_trees) ``leaves``;
     ``mean`` holds ``n_outputs`` values per sample.
     """
@@ -308,9 +417,9 @@ cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_obje
             for i in range(block * n_outputs, block_end * n_outputs):
                 mean[i] = 0.0
         for tree in range(n_trees):
-            _kernels.find_leaves(nodes + tree_offsets[tree], forest.extras, features, n_objects,
-                                 type_ptr + block * stride, stride, block_end - block,
-                                 block_leaves)
+            _kernels.find_leaves(nodes + tree_offsets[tree], forest.extras, forest.chains,
+                                 features, n_objects, positions, type_ptr + block * stride, stride,
+                                 block_end - block, block_leaves)
             for i in range(block, block_end):
                 leaf = block_leaves[i - block]
                 if mean == NULL:

@@ -9,8 +9,9 @@
  *   samples (new id < mid) before those of the right child's;
  * - find_leaves: walk samples down one tree (the AVX-512 version walks BOXTREES_WALKS samples
  *   side by side: for a sample of at most sixteen objects a node tests all of them in one
- *   load and keeps the lanes of its type; for a larger one, up to sixteen of its objects of
- *   the node's type at once).
+ *   load and keeps the lanes of its type, and a chain of up to sixteen nodes that mostly send
+ *   samples left is tested at once; for a larger one, up to sixteen of its objects of the
+ *   node's type at once).
  *
  * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
  * run time, so the default build stays portable) sixteen objects are handled per step; with
@@ -57,7 +58,8 @@ typedef int64_t (*boxtrees_partition_fn)(float *xs, float *ys, int32_t *sid, int
    the box (xmin, xmax, ymin, ymax) bounds the attributes x_column and y_column (the same
    column, with an unbounded y extent, for a box over one attribute). A box over more
    attributes bounds the others in `extra`: entries extras[extra], extras[extra + 1], ... up
-   to one whose column is -1; extra = -1: none. */
+   to one whose column is -1; extra = -1: none; extra <= -2: none, and the node is lane 0 of
+   chain -2 - extra (see boxtrees_chain). */
 typedef struct {
     int32_t left;
     int32_t right;
@@ -76,12 +78,38 @@ typedef struct {
     float high;
 } boxtrees_extra;
 
+/* Up to BOXTREES_CHAIN_LANES consecutive inner nodes of a tree, each but the last the left
+   child of the one before (the builder puts a left child right after its parent, and most
+   samples go left), whose boxes bound the same two attributes and no others, laid out lane by
+   lane (built by boxtrees._predictor.PackedForest; a node test as in boxtrees_node): the
+   AVX-512 walk tests a sample against all of them at once and leaves the chain at the first
+   node that sends it right, or at the last one's left child. Lanes from n on are unused:
+   type -1, threshold INT32_MAX. */
+#define BOXTREES_CHAIN_LANES 16
+typedef struct {
+    int32_t first;              /* tree-local id of lane 0's node */
+    int32_t n;                  /* lanes in use, 1 to BOXTREES_CHAIN_LANES */
+    int32_t x_column;
+    int32_t y_column;
+    int32_t max_objects;        /* walked as a chain by samples of at most this many objects */
+    int32_t type[BOXTREES_CHAIN_LANES];         /* the type position each lane tests */
+    float x0[BOXTREES_CHAIN_LANES];
+    float x1[BOXTREES_CHAIN_LANES];
+    float y0[BOXTREES_CHAIN_LANES];
+    float y1[BOXTREES_CHAIN_LANES];
+    int32_t threshold[BOXTREES_CHAIN_LANES];
+} boxtrees_chain;
+
 /* The tree-local leaves that n_samples samples reach from root `nodes`, into out[i]: attribute
    c of sample i's objects of type t is features[c * stride + ts[t]] to
-   features[c * stride + ts[t + 1] - 1], ts = types + i * types_stride. */
+   features[c * stride + ts[t + 1] - 1], ts = types + i * types_stride, and positions[k] is
+   the type position of object k (the portable walk reads neither the chains nor the
+   positions). */
 typedef void (*boxtrees_find_leaves_fn)(const boxtrees_node *nodes,
-                                        const boxtrees_extra *extras, const float *features,
-                                        int64_t stride, const int64_t *types,
+                                        const boxtrees_extra *extras,
+                                        const boxtrees_chain *chains,
+                                        const float *features, int64_t stride,
+                                        const int32_t *positions, const int64_t *types,
                                         int64_t types_stride, int64_t n_samples, int64_t *out);
 
 /* Samples walked side by side by the AVX-512 find_leaves. */
@@ -234,10 +262,14 @@ static int64_t boxtrees_find_leaf_portable(const boxtrees_node *nodes,
 /* The leaves of `n_samples` samples in one tree: sample i's type offsets start at
    types + i * types_stride, its leaf goes to out[i]. */
 static void boxtrees_find_leaves_portable(const boxtrees_node *nodes,
-                                          const boxtrees_extra *extras, const float *features,
-                                          int64_t stride, const int64_t *types,
-                                          int64_t types_stride, int64_t n_samples, int64_t *out)
+                                          const boxtrees_extra *extras,
+                                          const boxtrees_chain *chains, const float *features,
+                                          int64_t stride, const int32_t *positions,
+                                          const int64_t *types, int64_t types_stride,
+                                          int64_t n_samples, int64_t *out)
 {
+    (void)chains;
+    (void)positions;
     for (int64_t i = 0; i < n_samples; i++)
         out[i] = boxtrees_find_leaf_portable(nodes, extras, features, stride,
                                              types + i * types_stride);
@@ -499,6 +531,36 @@ static inline const boxtrees_node *boxtrees_next_avx512(const boxtrees_node *nod
     return nodes + (count < n->threshold ? n->left : n->right);
 }
 
+/* The node a sample of at most 16 objects, first to end - 1, reaches from chain `c` (see
+   boxtrees_chain): each object is tested against every lane's box and type at once (the
+   loop's length is the sample's, the same in every chain, so its end is predicted), and the
+   exit is chosen without a branch (where a walk turns right is not predictable). */
+__attribute__((target("avx512f")))
+static inline const boxtrees_node *boxtrees_chain_next_avx512(const boxtrees_node *nodes,
+                                                              const boxtrees_chain *c,
+                                                              const float *features,
+                                                              int64_t stride,
+                                                              const int32_t *positions,
+                                                              int64_t first, int64_t end)
+{
+    const __m512 x0 = _mm512_loadu_ps(c->x0), x1 = _mm512_loadu_ps(c->x1);
+    const __m512 y0 = _mm512_loadu_ps(c->y0), y1 = _mm512_loadu_ps(c->y1);
+    const __m512i type = _mm512_loadu_si512((const void *)c->type);
+    const __m512i one = _mm512_set1_epi32(1);
+    const float *x = features + c->x_column * stride, *y = features + c->y_column * stride;
+    __m512i count = _mm512_setzero_si512();
+    for (int64_t k = first; k < end; k++) {
+        __mmask16 in = _mm512_cmpeq_epi32_mask(type, _mm512_set1_epi32(positions[k]))
+                       & boxtrees_in_box_avx512(_mm512_set1_ps(x[k]), _mm512_set1_ps(y[k]),
+                                                x0, x1, y0, y1);
+        count = _mm512_mask_add_epi32(count, in, count, one);
+    }
+    unsigned right = (unsigned)_mm512_cmpge_epi32_mask(
+        count, _mm512_loadu_si512((const void *)c->threshold));
+    const boxtrees_node *exit = nodes + c->first + (right ? __builtin_ctz(right) : c->n - 1);
+    return nodes + (right ? exit->right : exit->left);
+}
+
 /* The child of inner node `n` for a sample of at most 16 objects (of the forest's types):
    its objects of every type are lanes 0 to popcount(live) - 1 of one load at features + c *
    stride + base, those of type position t lanes types[t] - base to types[t + 1] - base. The
@@ -531,10 +593,12 @@ static inline const boxtrees_node *boxtrees_next16_avx512(const boxtrees_node *n
    next. With `short_sets` every sample has at most 16 objects (boxtrees_next16_avx512). */
 __attribute__((target("avx512f"), always_inline))
 static inline void boxtrees_walk_avx512(const boxtrees_node *nodes,
-                                        const boxtrees_extra *extras, const float *features,
-                                        int64_t stride, const int64_t *types,
-                                        int64_t types_stride, const int64_t *ids, int n_walks,
-                                        int64_t *out, int short_sets)
+                                        const boxtrees_extra *extras,
+                                        const boxtrees_chain *chains, const float *features,
+                                        int64_t stride, const int32_t *positions,
+                                        const int64_t *types, int64_t types_stride,
+                                        const int64_t *ids, int n_walks, int64_t *out,
+                                        int short_sets)
 {
     const boxtrees_node *at[BOXTREES_WALKS];
     const int64_t *ts[BOXTREES_WALKS];
@@ -551,10 +615,17 @@ static inline void boxtrees_walk_avx512(const boxtrees_node *nodes,
         walking = 0;
         for (int w = 0; w < n_walks; w++)
             if (at[w]->left != -1) {
-                at[w] = short_sets ? boxtrees_next16_avx512(nodes, at[w], extras, features,
-                                                            stride, ts[w], base[w], live[w])
-                                   : boxtrees_next_avx512(nodes, at[w], extras, features,
-                                                          stride, ts[w]);
+                int32_t chain = -2 - at[w]->extra;
+                if (short_sets && chain >= 0
+                    && ts[w][types_stride - 1] - base[w] <= chains[chain].max_objects)
+                    at[w] = boxtrees_chain_next_avx512(nodes, chains + chain, features, stride,
+                                                       positions, base[w],
+                                                       ts[w][types_stride - 1]);
+                else if (short_sets)
+                    at[w] = boxtrees_next16_avx512(nodes, at[w], extras, features, stride,
+                                                   ts[w], base[w], live[w]);
+                else
+                    at[w] = boxtrees_next_avx512(nodes, at[w], extras, features, stride, ts[w]);
                 walking = 1;
             }
     } while (walking);
@@ -566,9 +637,11 @@ static inline void boxtrees_walk_avx512(const boxtrees_node *nodes,
    BOXTREES_WALKS of a queue at a time (boxtrees_walk_avx512). */
 __attribute__((target("avx512f")))
 static void boxtrees_find_leaves_avx512(const boxtrees_node *nodes,
-                                        const boxtrees_extra *extras, const float *features,
-                                        int64_t stride, const int64_t *types,
-                                        int64_t types_stride, int64_t n_samples, int64_t *out)
+                                        const boxtrees_extra *extras,
+                                        const boxtrees_chain *chains, const float *features,
+                                        int64_t stride, const int32_t *positions,
+                                        const int64_t *types, int64_t types_stride,
+                                        int64_t n_samples, int64_t *out)
 {
     int64_t ids[2][BOXTREES_WALKS];
     int n_queued[2] = {0, 0};
@@ -579,17 +652,17 @@ static void boxtrees_find_leaves_avx512(const boxtrees_node *nodes,
         if (n_queued[short_set] < BOXTREES_WALKS)
             continue;
         if (short_set)
-            boxtrees_walk_avx512(nodes, extras, features, stride, types, types_stride, ids[1],
-                                 BOXTREES_WALKS, out, 1);
+            boxtrees_walk_avx512(nodes, extras, chains, features, stride, positions,
+                                 types, types_stride, ids[1], BOXTREES_WALKS, out, 1);
         else
-            boxtrees_walk_avx512(nodes, extras, features, stride, types, types_stride, ids[0],
-                                 BOXTREES_WALKS, out, 0);
+            boxtrees_walk_avx512(nodes, extras, chains, features, stride, positions,
+                                 types, types_stride, ids[0], BOXTREES_WALKS, out, 0);
         n_queued[short_set] = 0;
     }
-    boxtrees_walk_avx512(nodes, extras, features, stride, types, types_stride, ids[0],
-                         n_queued[0], out, 0);
-    boxtrees_walk_avx512(nodes, extras, features, stride, types, types_stride, ids[1],
-                         n_queued[1], out, 1);
+    boxtrees_walk_avx512(nodes, extras, chains, features, stride, positions, types,
+                         types_stride, ids[0], n_queued[0], out, 0);
+    boxtrees_walk_avx512(nodes, extras, chains, features, stride, positions, types,
+                         types_stride, ids[1], n_queued[1], out, 1);
 }
 #endif
 

@@ -1,6 +1,6 @@
 # The kernels of _simd.h, declared once for the Cython modules (the records they read are
 # declared in _tree.pxd).
-from ._tree cimport boxtrees_extra, boxtrees_node
+from ._tree cimport boxtrees_chain, boxtrees_extra, boxtrees_node
 from ._utils cimport coord_t, int32, intp_t
 
 
@@ -20,7 +20,8 @@ cdef extern from "_simd.h":
                             const int32* new_id, int32 mid, coord_t* tmp_x, coord_t* tmp_y,
                             int32* tmp_sid) noexcept nogil
         void (*find_leaves)(const boxtrees_node* nodes, const boxtrees_extra* extras,
-                            const coord_t* features, intp_t stride, const intp_t* types,
-                            intp_t types_stride, intp_t n_samples, intp_t* out) noexcept nogil
+                            const boxtrees_chain* chains, const coord_t* features, intp_t stride, const int32* positions,
+                            const intp_t* types, intp_t types_stride, intp_t n_samples,
+                            intp_t* out) noexcept nogil
         int lanes
     boxtrees_kernels boxtrees_select_kernels(int max_lanes) noexcept nogil

@@ -64,3 +64,16 @@ cdef extern from "_simd.h":
         int32 column
         coord_t low
         coord_t high
+    enum: BOXTREES_CHAIN_LANES
+    ctypedef struct boxtrees_chain:     # consecutive nodes of a left chain, lane by lane
+        int32 first
+        int32 n
+        int32 x_column
+        int32 y_column
+        int32 max_objects
+        int32 type[BOXTREES_CHAIN_LANES]
+        coord_t x0[BOXTREES_CHAIN_LANES]
+        coord_t x1[BOXTREES_CHAIN_LANES]
+        coord_t y0[BOXTREES_CHAIN_LANES]
+        coord_t y1[BOXTREES_CHAIN_LANES]
+        int32 threshold[BOXTREES_CHAIN_LANES]

@@ -36,6 +36,24 @@ def run_in_fork(check, timeout=60):
     return answer == b"1"
 
 
+def reference_leaf(tree, objects):
+    """Walk one tree in plain NumPy, reading only its exported node arrays: an object
+    (``[f_1, ..., f_d, type]``) is inside a box when every attribute lies strictly between
+    its bounds."""
+    import numpy as np
+
+    objects = np.asarray(objects, dtype=np.float32).reshape(-1, tree.box.shape[1] // 2 + 1)
+    d = objects.shape[1] - 1
+    node = 0
+    while tree.children_left[node] != -1:
+        box = tree.box[node].reshape(d, 2)
+        mine = objects[objects[:, d] == tree.object_type[node], :d]
+        inside = ((mine > box[:, 0]) & (mine < box[:, 1])).all(axis=1)
+        go_left = inside.sum() < tree.threshold[node]
+        node = tree.children_left[node] if go_left else tree.children_right[node]
+    return node
+
+
 # The engine as the thesis ran it (fqi.make_box_forest): fixed boxes of half-width 1 in the
 # data's units, neither refined nor grown on bootstrap samples. The engine's own tests pin it;
 # the estimators' defaults are measured elsewhere (tests/test_boxtrees_defaults.py).

@@ -14,7 +14,7 @@ import boxtrees._threads
 from boxtrees import BoxExtraTreesRegressor, GridCounts, ObjectSets, make_box_regression
 from boxtrees._rows import RowProblem
 from boxtrees._threads import thread_pool, threads_for
-from conftest import THESIS_FOREST, run_in_fork
+from conftest import THESIS_FOREST, reference_leaf, run_in_fork
 
 
 def thesis_forest(*args, **params):
@@ -36,19 +36,6 @@ def random_sets(rng, n, max_objects=10, n_types=4, extent=5.0):
 def trees_of(forest):
     """The node arrays of a forest's trees."""
     return [estimator.tree_ for estimator in forest]
-
-
-def reference_leaf(tree, objects):
-    """Walk one tree in plain NumPy, reading only its exported node arrays."""
-    objects = np.asarray(objects, dtype=np.float32).reshape(-1, 3)
-    node = 0
-    while tree.children_left[node] != -1:
-        xmin, xmax, ymin, ymax = tree.box[node]
-        mine = objects[objects[:, 2] == tree.object_type[node]]
-        inside = (mine[:, 0] > xmin) & (mine[:, 0] < xmax) & (mine[:, 1] > ymin) & (mine[:, 1] < ymax)
-        go_left = inside.sum() < tree.threshold[node]
-        node = tree.children_left[node] if go_left else tree.children_right[node]
-    return node
 
 
 KERNEL_WIDTHS = {"avx512": 16, "avx2": 8}  # the SIMD kernels' lanes, widest first
@@ -96,6 +83,64 @@ def test_predict_matches_numpy_reference_traversal(test_type, traversal_kernel):
     np.testing.assert_array_equal(forest.apply(X_new), leaves)
     np.testing.assert_allclose(forest.predict(X_new), expected, rtol=1e-12)
     assert all(t.node_count > 20 for t in trees_of(forest))
+
+
+def spine_forest(d, rng):
+    """A forest of long unbalanced spines, as box tests grow on sparse objects (the thesis's
+    game): most tests split off the few samples with an object in their small box. Objects
+    have ``d`` attributes; with 3, boxes over columns (0, 1) and (0, 1, 2) alternate."""
+    X = [np.column_stack([rng.uniform(-10, 10, (k, d)), rng.integers(0, 4, k)])
+         for k in rng.integers(2, 13, 2000)]
+    y = np.array([float((s[:, 0] > 5).sum()) for s in X]) + rng.normal(size=len(X))
+    return thesis_forest(n_estimators=4, n_tests=40, min_samples_split=10,
+                         random_state=0).fit(X, y)
+
+
+def sets_of(rng, d, sizes):
+    """One set of each size in ``sizes``: objects of ``d`` attributes and 4 types."""
+    return [np.column_stack([rng.uniform(-10, 10, (k, d)), rng.integers(0, 4, k)])
+            for k in sizes]
+
+
+@pytest.mark.parametrize("d", [1, 2, 3])
+def test_left_chains_walk_to_the_leaves_of_the_reference_traversal(d, traversal_kernel):
+    # the AVX-512 walk tests a run of nodes that mostly send samples left at once (sets of up
+    # to 16 objects); the leaves are those of a walk node by node
+    rng = np.random.default_rng(d)
+    forest = spine_forest(d, rng)
+    assert forest._packed.n_chains > 0
+    X_new = sets_of(rng, d, list(range(17)) * 20 + [17, 30])
+    leaves = np.array([[reference_leaf(t, s) for t in trees_of(forest)] for s in X_new])
+    np.testing.assert_array_equal(forest.apply(X_new), leaves)
+
+
+def test_training_counts_pick_the_chains_and_change_no_leaf(traversal_kernel):
+    # which nodes form chains follows each tree's n_node_samples; counts that are unknown or
+    # false change the chains (and the speed), never a leaf
+    from boxtrees import BoxTree
+    from boxtrees._predictor import PackedForest, apply_leaves
+
+    rng = np.random.default_rng(4)
+    forest = spine_forest(2, rng)
+    batch = ObjectSets.from_sequence(sets_of(rng, 2, list(range(17)) * 10))
+    expected = np.array([[reference_leaf(t, s) for t in trees_of(forest)] for s in batch])
+    arrays = [{name: getattr(t, name) for name in t.__annotations__} for t in trees_of(forest)]
+    n_chains = []
+    for counts in (None, -1, "random", "huge"):
+        trees = []
+        for a in arrays:
+            n = len(a["value"])
+            false = {None: a["n_node_samples"], -1: np.full(n, -1),
+                     "random": rng.integers(-2, 50, n), "huge": np.full(n, 2**40)}[counts]
+            trees.append(BoxTree(**{**a, "n_node_samples": false}))
+        packed = PackedForest(trees, forest.types_)
+        leaves = np.empty((len(batch), len(trees)), dtype=np.intp)
+        assert apply_leaves(packed, batch.data, batch.offsets, leaves) == (0, -1)
+        np.testing.assert_array_equal(leaves, expected)
+        n_chains.append(packed.n_chains)
+    true, unknown, random, huge = n_chains
+    assert true == forest._packed.n_chains > 0 and unknown == 0 and random != true
+    assert huge == 0  # equal counts: every node seems to send all its samples right
 
 
 def test_node_arrays_are_consistent_with_training_data():

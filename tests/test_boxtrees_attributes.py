@@ -7,6 +7,7 @@ from sklearn.metrics import r2_score
 
 from boxtrees import (BoxExtraTreeClassifier, BoxExtraTreeRegressor, BoxExtraTreesClassifier,
                       BoxExtraTreesRegressor, GridCounts, ObjectSets)
+from conftest import reference_leaf
 
 ESTIMATORS = (BoxExtraTreesRegressor, BoxExtraTreesClassifier, BoxExtraTreeRegressor,
               BoxExtraTreeClassifier)
@@ -16,21 +17,6 @@ def object_sets(rng, n, d, max_objects=12, n_types=3, extent=5.0):
     """Ragged sets of objects with ``d`` attributes, many of them empty."""
     return [np.column_stack([rng.uniform(-extent, extent, (k, d)), rng.integers(0, n_types, k)])
             for k in rng.integers(0, max_objects + 1, n)]
-
-
-def reference_leaf(tree, objects):
-    """Walk one tree in plain NumPy: an object is inside a box when every attribute lies
-    strictly between its bounds."""
-    objects = np.asarray(objects, dtype=np.float32)
-    d = objects.shape[1] - 1
-    node = 0
-    while tree.children_left[node] != -1:
-        box = tree.box[node].reshape(d, 2)
-        mine = objects[objects[:, d] == tree.object_type[node], :d]
-        inside = ((mine > box[:, 0]) & (mine < box[:, 1])).all(axis=1)
-        go_left = inside.sum() < tree.threshold[node]
-        node = tree.children_left[node] if go_left else tree.children_right[node]
-    return node
 
 
 def _small(estimator_class, **params):

@@ -170,7 +170,8 @@ def test_fuzz_batches_mutated_after_validation_predict_or_raise_value_error(fore
     assert pred.shape == (n_sets,) and np.isfinite(pred).all()
 
 
-int_edit = st.tuples(st.sampled_from(NODE_ARRAYS[:3] + ("threshold",)), st.integers(0, 10**6),
+int_edit = st.tuples(st.sampled_from(NODE_ARRAYS[:3] + ("threshold", "n_node_samples")),
+                    st.integers(0, 10**6),
                     st.integers(-3, 60) | st.sampled_from([2**31, -(2**31) - 1, 10**12]))
 float_edit = st.tuples(st.sampled_from(("box", "value")), st.integers(0, 10**6),
                        st.floats(allow_nan=True, width=32))
