@@ -9,9 +9,9 @@
  *   samples (new id < mid) before those of the right child's;
  * - find_leaves: walk samples down one tree (the AVX-512 version walks BOXTREES_WALKS samples
  *   side by side: for a sample of at most sixteen objects a node tests all of them in one
- *   load and keeps the lanes of its type, and a chain of up to sixteen nodes that mostly send
- *   samples left is tested at once; for a larger one, up to sixteen of its objects of the
- *   node's type at once).
+ *   load and keeps the lanes of its type; for a larger one, up to sixteen of its objects of
+ *   the node's type at once; and a chain of up to sixteen nodes that mostly send samples left
+ *   is tested at once).
  *
  * The portable versions are branch-free scalar loops. On x86-64 CPUs with AVX-512F (checked at
  * run time, so the default build stays portable) sixteen objects are handled per step; with
@@ -531,10 +531,11 @@ static inline const boxtrees_node *boxtrees_next_avx512(const boxtrees_node *nod
     return nodes + (count < n->threshold ? n->left : n->right);
 }
 
-/* The node a sample of at most 16 objects, first to end - 1, reaches from chain `c` (see
-   boxtrees_chain): each object is tested against every lane's box and type at once (the
-   loop's length is the sample's, the same in every chain, so its end is predicted), and the
-   exit is chosen without a branch (where a walk turns right is not predictable). */
+/* The node a sample, objects first to end - 1, reaches from chain `c` (see boxtrees_chain):
+   each object is tested against every lane's box and type at once (the loop's length is the
+   sample's, the same in every chain, so its end is predicted; a count fits its lane as long
+   as the sample has fewer than INT32_MAX objects), and the exit is chosen without a branch
+   (where a walk turns right is not predictable). */
 __attribute__((target("avx512f")))
 static inline const boxtrees_node *boxtrees_chain_next_avx512(const boxtrees_node *nodes,
                                                               const boxtrees_chain *c,
@@ -616,8 +617,7 @@ static inline void boxtrees_walk_avx512(const boxtrees_node *nodes,
         for (int w = 0; w < n_walks; w++)
             if (at[w]->left != -1) {
                 int32_t chain = -2 - at[w]->extra;
-                if (short_sets && chain >= 0
-                    && ts[w][types_stride - 1] - base[w] <= chains[chain].max_objects)
+                if (chain >= 0 && ts[w][types_stride - 1] - base[w] <= chains[chain].max_objects)
                     at[w] = boxtrees_chain_next_avx512(nodes, chains + chain, features, stride,
                                                        positions, base[w],
                                                        ts[w][types_stride - 1]);

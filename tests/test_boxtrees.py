@@ -105,11 +105,12 @@ def sets_of(rng, d, sizes):
 @pytest.mark.parametrize("d", [1, 2, 3])
 def test_left_chains_walk_to_the_leaves_of_the_reference_traversal(d, traversal_kernel):
     # the AVX-512 walk tests a run of nodes that mostly send samples left at once (sets of up
-    # to 16 objects); the leaves are those of a walk node by node
+    # to 16 objects and larger ones walk differently); the leaves are those of a walk node by
+    # node
     rng = np.random.default_rng(d)
     forest = spine_forest(d, rng)
     assert forest._packed.n_chains > 0
-    X_new = sets_of(rng, d, list(range(17)) * 20 + [17, 30])
+    X_new = sets_of(rng, d, list(range(17)) * 20 + [17, 20, 24, 30, 32, 40] * 5)
     leaves = np.array([[reference_leaf(t, s) for t in trees_of(forest)] for s in X_new])
     np.testing.assert_array_equal(forest.apply(X_new), leaves)
 
