@@ -5,8 +5,8 @@ from __future__ import annotations
 import inspect
 import warnings
 from collections.abc import Mapping
-from concurrent.futures import wait
 from dataclasses import dataclass
+from functools import partial
 from math import ceil
 from numbers import Integral, Real
 
@@ -25,7 +25,7 @@ from ._objects import (_FLOAT32_MAX, ObjectInputMixin, check_view_bounds, column
 from ._predictor import PackedForest, apply_leaves, predict_mean
 from ._rows import RowProblem
 from ._splitter import TEST_KINDS
-from ._threads import thread_pool, threads_for
+from ._threads import side_by_side, threads_for
 from ._typing import SetsOrMatrix
 
 # prediction splits a batch into chunks of at least this many samples, one per thread,
@@ -143,20 +143,9 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
             results = [kernel(packed, sets.data, sets.offsets, out)]
         else:
             edges = np.linspace(0, n, n_chunks + 1).astype(np.intp)
-
-            def chunk(a, b):
-                return kernel(packed, sets.data, sets.offsets[a : b + 1], out[a:b])
-
-            # the first chunk in this thread, which would otherwise only wait; the others in
-            # a pool of one thread fewer than the call may use (one pool whatever the batch)
-            pool, others = thread_pool(n_threads - 1, _PREDICT_POOL), []
-            try:
-                for a, b in zip(edges[1:-1], edges[2:]):
-                    others.append(pool.submit(chunk, a, b))
-                results = [chunk(edges[0], edges[1])]
-            finally:
-                wait(others)    # no chunk outlives the call, even if this one failed
-            results += [future.result() for future in others]
+            results = side_by_side(     # one pool whatever the number of chunks
+                [partial(kernel, packed, sets.data, sets.offsets[a : b + 1], out[a:b])
+                 for a, b in zip(edges[:-1], edges[1:])], _PREDICT_POOL, n_threads)
         for problem, row in results:
             if problem == RowProblem.BAD_OFFSETS:
                 raise ValueError("the offsets of X changed while it was being read")

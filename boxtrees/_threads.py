@@ -1,18 +1,23 @@
 """Long-lived thread pools, one per purpose and size, started on first use and forgotten in
-a forked child (whose parent's threads are gone), and the share of the cores a call made
-from one of their threads may use."""
+a forked child (whose parent's threads are gone); tasks run side by side in the calling
+thread and a pool's; and the share of the cores a call made from one of those threads may
+use."""
 import os
 import threading
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor, wait
+from typing import TypeVar
 
 from joblib import effective_n_jobs
 
-__all__ = ["thread_pool", "threads_for"]
+__all__ = ["side_by_side", "thread_pool", "threads_for"]
+
+T = TypeVar("T")
 
 # (purpose, threads) -> the pool of this process
 _POOLS: dict[tuple[str, int], ThreadPoolExecutor] = {}
 _POOLS_LOCK = threading.Lock()
-# in a pool's thread: `siblings`, the number of threads of that pool
+# in a thread running tasks side by side: `siblings`, the number of threads that run them
 _LOCAL = threading.local()
 
 
@@ -30,7 +35,7 @@ if hasattr(os, "register_at_fork"):
 
 
 def _join_pool(n_threads):
-    _LOCAL.siblings = n_threads
+    _LOCAL.siblings = n_threads + 1     # (the pool's threads work beside the calling one)
 
 
 def thread_pool(n_threads: int, purpose: str) -> ThreadPoolExecutor:
@@ -41,8 +46,9 @@ def thread_pool(n_threads: int, purpose: str) -> ThreadPoolExecutor:
     work; the kernels release the GIL, so long-lived threads share a batch at no such cost.
     Pools of different purposes are distinct, so that work in one pool may wait on work in
     another (an agent's per-action predictions on a forest's own) without deadlock, but
-    never on work in its own; work run in a pool's thread takes its share of the cores
-    (`threads_for`).
+    never on work in its own. A pool's threads work beside the calling thread
+    (`side_by_side`): work run in one of them takes a share of the cores, one of ``n_threads
+    + 1`` (`threads_for`).
 
     Parameters
     ----------
@@ -62,12 +68,63 @@ def thread_pool(n_threads: int, purpose: str) -> ThreadPoolExecutor:
         return _POOLS[key]
 
 
+def side_by_side(tasks: Sequence[Callable[[], T]], purpose: str,
+                 n_threads: int | None = None) -> list[T]:
+    """The results of the callables `tasks`, run side by side on `n_threads` threads: the
+    first task in the calling thread (which would otherwise only wait), each other one in a
+    thread of the pool of `purpose` of ``n_threads - 1`` threads (`thread_pool`); each runs
+    as one of `n_threads` siblings (`threads_for`).
+
+    Returns only when every task has finished, even when one failed (the first failure is
+    then raised): no task outlives the call, so none writes into what the caller frees.
+
+    Parameters
+    ----------
+    tasks : sequence of callables
+        Each called with no argument.
+    purpose : str
+        The pool's (see `thread_pool`).
+    n_threads : int, default=len(tasks)
+        At least ``len(tasks)``: one pool serves calls of fewer tasks too.
+
+    Returns
+    -------
+    results : list
+        Their results, in the order of `tasks`.
+
+    Examples
+    --------
+    >>> from boxtrees._threads import side_by_side, threads_for
+    >>> side_by_side([lambda: threads_for(-1), lambda: 2 + 2], "example")[1]
+    4
+    """
+    n_threads = len(tasks) if n_threads is None else n_threads
+    if n_threads < len(tasks):
+        raise ValueError(f"{len(tasks)} tasks side by side need as many threads, not {n_threads}")
+    if n_threads == 1:
+        return [tasks[0]()]
+    pool, others = thread_pool(n_threads - 1, purpose), []
+    outside = getattr(_LOCAL, "siblings", None)
+    try:
+        others = [pool.submit(task) for task in tasks[1:]]
+        _LOCAL.siblings = n_threads
+        first = tasks[0]()
+    finally:
+        if outside is None:
+            vars(_LOCAL).pop("siblings", None)
+        else:
+            _LOCAL.siblings = outside
+        wait(others)
+    return [first] + [future.result() for future in others]
+
+
 def threads_for(n_jobs: int | None) -> int:
     """The threads a call with `n_jobs` may use: joblib's ``effective_n_jobs(n_jobs)``,
-    divided among the threads of the pool the calling thread belongs to, if any (at least 1).
+    divided among the threads running tasks side by side with the calling one, if any (at
+    least 1).
 
-    A pool's threads already keep that many cores busy: a forest predicting in each of the 2
-    threads of an agent's per-action pool, on 2 cores, predicts its whole batch in its
+    Those threads already keep that many cores busy: a forest predicting in each of the 2
+    threads of an agent's per-action tasks, on 2 cores, predicts its whole batch in its
     caller's thread instead of splitting it with a thread of its own (4 busy threads on 2
     cores only add switching).
 
@@ -86,7 +143,7 @@ def threads_for(n_jobs: int | None) -> int:
     >>> from boxtrees._threads import thread_pool, threads_for
     >>> threads_for(1)
     1
-    >>> thread_pool(4, "example").submit(threads_for, 8).result()
+    >>> thread_pool(3, "example").submit(threads_for, 8).result()
     2
     """
     return max(effective_n_jobs(n_jobs) // getattr(_LOCAL, "siblings", 1), 1)

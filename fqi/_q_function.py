@@ -1,10 +1,11 @@
 """The Q-function of an FQI iteration: one fitted clone of the regressor per action."""
 import warnings
+from functools import partial
 
 import numpy as np
 from sklearn.base import clone
 
-from boxtrees._threads import thread_pool, threads_for
+from boxtrees._threads import side_by_side, threads_for
 
 __all__ = []
 
@@ -90,15 +91,15 @@ class _QFunction:
 
     def values(self, batch, n_jobs=1):
         """``Q(s, a)`` of every action for the observations of `batch`, shape ``(n,
-        n_actions)``, predicted in up to `n_jobs` threads (one action each; a box forest
-        then predicts on its share of the cores, see `boxtrees._threads.threads_for`) and
-        checked to be one finite value per observation."""
+        n_actions)``, predicted in up to `n_jobs` threads, the calling one among them (the
+        actions split between them; a box forest then predicts on its share of the cores,
+        see `boxtrees._threads.threads_for`) and checked to be one finite value per
+        observation."""
         n_threads = min(threads_for(n_jobs), len(self.models))
-        if n_threads == 1:
-            predictions = [model.predict(batch) for model in self.models]
-        else:
-            predictions = thread_pool(n_threads, "fqi-actions").map(
-                lambda model: model.predict(batch), self.models)
+        edges = np.linspace(0, len(self.models), n_threads + 1).astype(int)
+        predictions = [prediction for part in side_by_side(
+            [partial(_predictions, self.models[a:b], batch) for a, b in zip(edges, edges[1:])],
+            "fqi-actions") for prediction in part]
         q = np.empty((len(batch), len(self.models)))
         for action, prediction in enumerate(predictions):
             q[:, action] = _checked_prediction(
@@ -192,6 +193,11 @@ def _with_actions(states, actions, n_actions):
     onehot = np.zeros((len(states), n_actions), dtype=states.dtype)
     onehot[np.arange(len(states)), actions] = 1
     return np.hstack([states, onehot])
+
+
+def _predictions(models, batch):
+    """Each of `models`' ``predict(batch)``, in a list."""
+    return [model.predict(batch) for model in models]
 
 
 def _seeded_clone(regressor, rng):

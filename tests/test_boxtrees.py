@@ -237,7 +237,8 @@ def test_parallel_predict_equals_serial_predict(n, n_jobs):
 
 
 def test_a_forest_in_a_pool_thread_predicts_on_its_share_of_the_cores(monkeypatch):
-    # in one of 2 threads of an agent's pool, n_jobs=2 is one thread: the caller's own
+    # in the one thread of a pool working beside the calling thread, n_jobs=2 is one
+    # thread: the caller's own
     X, y = make_box_regression(500, random_state=0)
     forest = thesis_forest(n_estimators=4, n_tests=20, n_jobs=2, random_state=0).fit(X, y)
     expected = forest.predict(X)
@@ -245,11 +246,28 @@ def test_a_forest_in_a_pool_thread_predicts_on_its_share_of_the_cores(monkeypatc
     def no_pool(*args):
         raise AssertionError("predicted on threads of its own")
 
-    monkeypatch.setattr(boxtrees._base, "thread_pool", no_pool)
-    in_pool = thread_pool(2, "test-share").submit(forest.predict, X).result()
+    monkeypatch.setattr(boxtrees._threads, "thread_pool", no_pool)
+    in_pool = thread_pool(1, "test-share").submit(forest.predict, X).result()
     np.testing.assert_array_equal(in_pool, expected)
     with pytest.raises(AssertionError, match="threads of its own"):
         forest.predict(X)           # outside a pool: 2 threads, the caller and one more
+
+
+def test_side_by_side_runs_the_first_task_in_the_calling_thread_each_on_its_share():
+    import threading
+
+    from joblib import effective_n_jobs
+
+    def task():
+        return threading.current_thread(), threads_for(-1)
+
+    results = boxtrees._threads.side_by_side([task] * 3, "test-side", n_threads=4)
+    threads = [thread for thread, _ in results]
+    assert threads[0] is threading.current_thread() and len(set(threads)) == 3
+    assert [share for _, share in results] == [max(effective_n_jobs(-1) // 4, 1)] * 3
+    assert threads_for(-1) == effective_n_jobs(-1)   # the calling thread's share is restored
+    with pytest.raises(ValueError, match="3 tasks side by side need as many threads"):
+        boxtrees._threads.side_by_side([task] * 3, "test-side", n_threads=2)
 
 
 def test_predictions_of_any_batch_size_share_one_pool():
