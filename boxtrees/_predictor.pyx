@@ -298,10 +298,11 @@ cdef class PackedForest:
             return problem, row
         features_arr = np.zeros((n_attributes, pos), dtype=np.float32)
         cdef coord_t[:, ::1] features = features_arr
-        positions_arr = np.empty(pos, dtype=np.int32)    # each object's type position
+        # each object's type position, which only the walk of a chain reads
+        positions_arr = np.empty(pos if self.n_chains else 0, dtype=np.int32)
         cdef int32[::1] positions = positions_arr
         with nogil:
-            for i in range(n_sets):
+            for i in range(n_sets if self.n_chains else 0):
                 for d in range(self.n_types):
                     for k in range(type_ptr[i, d], type_ptr[i, d + 1]):
                         positions[k] = <int32>d
@@ -319,7 +320,8 @@ cdef class PackedForest:
                             features[c, cursor[d]] = data[k, c]
                         cursor[d] += 1
             _walk(&self._view, &features[0, 0] if pos else &_NO_OBJECT, pos,
-                  &positions[0] if pos else NULL, &type_ptr[0, 0] if n_sets > 0 else NULL,
+                  &positions[0] if positions.shape[0] else NULL,
+                  &type_ptr[0, 0] if n_sets > 0 else NULL,
                   stride, n_sets, mean, leaves)
         return ROW_OK, -1
 
@@ -418,8 +420,8 @@ cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_obje
                 mean[i] = 0.0
         for tree in range(n_trees):
             _kernels.find_leaves(nodes + tree_offsets[tree], forest.extras, forest.chains,
-                                 features, n_objects, positions, type_ptr + block * stride, stride,
-                                 block_end - block, block_leaves)
+                                 features, n_objects, positions, type_ptr + block * stride,
+                                 stride, block_end - block, block_leaves)
             for i in range(block, block_end):
                 leaf = block_leaves[i - block]
                 if mean == NULL:
