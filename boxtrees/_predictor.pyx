@@ -351,7 +351,7 @@ cdef intp_t _chains(boxtrees_node* nodes, const intp_t[::1] offsets,
     for tree in range(offsets.shape[0] - 1):
         o = offsets[tree]
         lanes = 0                  # of the open chain (first: its first node), 0: none
-        for i in range(offsets[tree + 1] - o + 1):
+        for i in range(offsets[tree + 1] - o + 1):     # (one past the last node: closes)
             node = nodes + o + i
             heavy = (i < offsets[tree + 1] - o and node.left != TREE_LEAF and node.extra < 0
                      and n_samples[o + i] > 0

@@ -106,7 +106,8 @@ def side_by_side(tasks: Sequence[Callable[[], T]], purpose: str,
     pool, others = thread_pool(n_threads - 1, purpose), []
     outside = getattr(_LOCAL, "siblings", None)
     try:
-        others = [pool.submit(task) for task in tasks[1:]]
+        for task in tasks[1:]:      # one by one: a failed submit still waits for the others
+            others.append(pool.submit(task))
         _LOCAL.siblings = n_threads
         first = tasks[0]()
     finally:

@@ -89,8 +89,7 @@ def spine_forest(d, rng):
     """A forest of long unbalanced spines, as box tests grow on sparse objects (the thesis's
     game): most tests split off the few samples with an object in their small box. Objects
     have ``d`` attributes; with 3, boxes over columns (0, 1) and (0, 1, 2) alternate."""
-    X = [np.column_stack([rng.uniform(-10, 10, (k, d)), rng.integers(0, 4, k)])
-         for k in rng.integers(2, 13, 2000)]
+    X = sets_of(rng, d, rng.integers(2, 13, 2000))
     y = np.array([float((s[:, 0] > 5).sum()) for s in X]) + rng.normal(size=len(X))
     return thesis_forest(n_estimators=4, n_tests=40, min_samples_split=10,
                          random_state=0).fit(X, y)
