@@ -130,15 +130,24 @@ cdef inline coord_t _key(double coordinate, intp_t side) noexcept nogil:
 cdef enum:
     LINEAR_RUN = 32
 
+cdef extern from *:
+    void __builtin_prefetch(const void* address) noexcept nogil
+
 
 cdef inline void _strip(const coord_t* x, intp_t lo, intp_t hi, coord_t xmin, coord_t xmax,
                         intp_t* first, intp_t* end) noexcept nogil:
     """``x[first:end]`` are the values in (xmin, xmax) of sorted ``x[lo:hi]``."""
     cdef const coord_t* above = x + lo      # searches the first x > xmin
     cdef const coord_t* beyond = x + lo     # searches the first x >= xmax
-    cdef intp_t n = hi - lo, half, i, a = 0, e = 0
+    cdef intp_t n = hi - lo, half, next_half, i, a = 0, e = 0
     while n > LINEAR_RUN:
         half = n >> 1
+        next_half = (n - half) >> 1
+        # the next step reads one of two places in each search: both start coming now
+        __builtin_prefetch(above + next_half)
+        __builtin_prefetch(above + half + next_half)
+        __builtin_prefetch(beyond + next_half)
+        __builtin_prefetch(beyond + half + next_half)
         above = above + half if above[half] <= xmin else above
         beyond = beyond + half if beyond[half] < xmax else beyond
         n -= half
