@@ -1,5 +1,6 @@
 """The Q-function of an FQI iteration: one fitted clone of the regressor per action."""
 import warnings
+from collections import deque
 from functools import partial
 
 import numpy as np
@@ -25,12 +26,18 @@ class _QFunction:
         self.models, self.iteration = models, iteration
 
     @classmethod
-    def fit(cls, regressor, data, targets, n_actions, rng, previous, iteration):
+    def fit(cls, regressor, data, targets, n_actions, rng, previous, iteration, n_jobs=1):
         """A clone of `regressor` per action, fitted on the transitions with that action;
         each clone's ``random_state`` parameters (nested ones too) drawn from `rng`. An action
         absent from the data keeps its `previous` model (with a warning), or is an error
-        without one."""
-        models = []
+        without one.
+
+        The clones are fitted side by side in up to `n_jobs` threads, the calling one among
+        them, each taking the next clone, the largest data sets first (a clone's own
+        threads, a forest's ``n_jobs``, are its own business): one clone's serial parts and
+        its last trees overlap the others' work instead of leaving cores idle.
+        """
+        models, fits = [], []
         for action in range(n_actions):
             mask = data.actions == action
             if not mask.any():
@@ -41,7 +48,12 @@ class _QFunction:
                               f"previous Q-function", RuntimeWarning, stacklevel=4)
                 models.append(previous.models[action])
                 continue
-            models.append(_seeded_clone(regressor, rng).fit(data.states[mask], targets[mask]))
+            models.append(_seeded_clone(regressor, rng))
+            fits.append((-mask.sum(), action, partial(_fit_into, models, action,
+                                                      data.states[mask], targets[mask])))
+        queue = deque(fit for _, _, fit in sorted(fits, key=lambda fit: fit[:2]))
+        side_by_side([partial(_run_all, queue)] * min(threads_for(n_jobs), max(len(fits), 1)),
+                     "fqi-actions")
         return cls(models, iteration)
 
     def future(self, data, n_jobs=1, split=None):
@@ -195,6 +207,22 @@ def _with_actions(states, actions, n_actions):
     return np.hstack([states, onehot])
 
 
+def _fit_into(models, index, X, y):
+    """Fit ``models[index]`` on ``X, y`` and put what its ``fit`` returns in its place."""
+    models[index] = models[index].fit(X, y)
+
+
+def _run_all(queue):
+    """Call the callables of `queue` (a deque, which other threads may share) until it is
+    empty."""
+    while True:
+        try:
+            task = queue.popleft()
+        except IndexError:
+            return
+        task()
+
+
 def _predictions(models, batch):
     """Each of `models`' ``predict(batch)``, in a list."""
     return [model.predict(batch) for model in models]
@@ -238,12 +266,13 @@ class _DoubleQFunction:
         return self.halves[0].iteration
 
     @classmethod
-    def fit(cls, regressor, data, targets, n_actions, rng, previous, iteration, split):
+    def fit(cls, regressor, data, targets, n_actions, rng, previous, iteration, split,
+            n_jobs=1):
         """`_QFunction.fit` on each half: the transitions of `split` (a mask of `data`),
         then the others; `previous` is the last `_DoubleQFunction`, or None."""
         return cls([_QFunction.fit(regressor, data[rows], targets[rows], n_actions, rng,
                                    None if previous is None else previous.halves[half],
-                                   iteration)
+                                   iteration, n_jobs)
                     for half, rows in enumerate((split, ~split))])
 
     def values(self, batch, n_jobs=1):

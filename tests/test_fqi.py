@@ -3,6 +3,7 @@ thesis's numbers, learning, baselines, bad input. Other envs: test_fqi_envs.py."
 import csv
 import os
 import pickle
+import threading
 
 import gymnasium as gym
 import joblib
@@ -579,3 +580,26 @@ def test_a_forked_child_predicts_with_threads_of_its_own():
     obs = np.zeros((3, 4), dtype=np.float32)
     expected = agent.q_values(obs)  # its thread pool exists before the fork
     assert run_in_fork(lambda: np.array_equal(agent.q_values(obs), expected))
+
+
+_MEETING = threading.Barrier(2, timeout=30)
+
+
+class MeetingRidge(Ridge):
+    """A Ridge whose fit on a Q-function's targets (not the agent's check, on zeros) first
+    waits for another to start: one after the other, those fits time out."""
+
+    def fit(self, X, y, sample_weight=None):
+        if np.any(y):
+            _MEETING.wait()
+        return super().fit(X, y, sample_weight)
+
+
+@pytest.mark.parametrize("double", [False, True])
+def test_n_jobs_fits_the_actions_side_by_side_to_the_same_models(double):
+    agents = [FQI(regressor, "CartPole-v1", samples_per_iteration=200, eval_episodes=0,
+                  double=double, n_jobs=n_jobs, seed=0).learn(n_iterations=2)
+              for regressor, n_jobs in ((MeetingRidge(), 2), (Ridge(), 1))]
+    obs = np.random.default_rng(0).normal(size=(20, 4))
+    np.testing.assert_array_equal(agents[0].q_values(obs), agents[1].q_values(obs))
+    assert not _MEETING.broken
