@@ -6,9 +6,11 @@ import os
 import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor, wait
+from functools import lru_cache
 from typing import TypeVar
 
 from joblib import effective_n_jobs
+from joblib.parallel import get_active_backend
 
 __all__ = ["side_by_side", "thread_pool", "threads_for"]
 
@@ -147,4 +149,16 @@ def threads_for(n_jobs: int | None) -> int:
     >>> thread_pool(3, "example").submit(threads_for, 8).result()
     2
     """
-    return max(effective_n_jobs(n_jobs) // getattr(_LOCAL, "siblings", 1), 1)
+    if n_jobs == 1:
+        return 1
+    backend, backend_n_jobs = get_active_backend()
+    return max(_effective_n_jobs(n_jobs, type(backend), backend_n_jobs)
+               // getattr(_LOCAL, "siblings", 1), 1)
+
+
+@lru_cache(maxsize=64)
+def _effective_n_jobs(n_jobs, backend_type, backend_n_jobs):
+    """joblib's ``effective_n_jobs(n_jobs)`` under an active backend of that type and
+    default: the same whenever they are (it counts the cores from the control groups'
+    files, as much time as predicting a sample)."""
+    return effective_n_jobs(n_jobs)

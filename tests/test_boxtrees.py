@@ -270,6 +270,18 @@ def test_side_by_side_runs_the_first_task_in_the_calling_thread_each_on_its_shar
         boxtrees._threads.side_by_side([task] * 3, "test-side", n_threads=2)
 
 
+def test_threads_for_follows_joblib_whatever_it_remembers():
+    from joblib import effective_n_jobs, parallel_config
+
+    for n_jobs in (-1, -2, None, 1, 3):
+        assert threads_for(n_jobs) == max(effective_n_jobs(n_jobs), 1)
+    with parallel_config(n_jobs=3):          # joblib's default n_jobs (None) changes
+        assert threads_for(None) == effective_n_jobs(None) == 3
+    with parallel_config(backend="sequential"):
+        assert threads_for(-1) == effective_n_jobs(-1) == 1
+    assert threads_for(None) == 1 and threads_for(-1) == effective_n_jobs(-1)
+
+
 def test_predictions_of_any_batch_size_share_one_pool():
     # one pool per thread count, not one per number of chunks a batch makes
     X, y = make_box_regression(512, random_state=0)
