@@ -152,7 +152,7 @@ def threads_for(n_jobs: int | None) -> int:
     if n_jobs == 1:
         return 1
     backend, backend_n_jobs = get_active_backend()
-    return max(_effective_n_jobs(n_jobs, type(backend), backend_n_jobs)
+    return max(_effective_n_jobs(n_jobs, backend.__class__, backend_n_jobs)
                // getattr(_LOCAL, "siblings", 1), 1)
 
 
