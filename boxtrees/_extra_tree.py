@@ -98,10 +98,11 @@ class _SingleTree(BaseBoxTrees):
         """
         return self._fit(self._fit_data(X, y, sample_weight), _tree_seed(self.random_state))
 
-    def _fit(self, data, seed, bootstrap=None):
+    def _fit(self, data, seed, bootstrap=None, pack=True):
         """Grow the tree of ``seed`` on validated training data (`_FitData`; with a
         `_Bootstrap`, on the bootstrap sample of ``seed``), taking the fitted attributes of
-        the data: a forest asks each of its trees to fit so, on the data it validated."""
+        the data: a forest asks each of its trees to fit so, on the data it validated, and
+        then hands each its share of the forest's packed trees (``pack=False``)."""
         for name, value in data.fitted.items():
             setattr(self, name, value)
         weight = data.sample_weight
@@ -115,7 +116,8 @@ class _SingleTree(BaseBoxTrees):
                                                      -data.w_exponent)
         self.tree_ = BoxTree.from_builder(self._node_arrays(arrays), self.types_,
                                           self.column_groups_, self.n_attributes_)
-        self._pack([self.tree_])
+        if pack:
+            self._pack([self.tree_])
         return self
 
     def _trees(self):

@@ -241,6 +241,27 @@ cdef class PackedForest:
         self.n_attributes = n_attributes
         self._dense = types.max() == len(types) - 1
 
+    def tree(self, intp_t k):
+        """Tree ``k`` alone, as a forest of one that shares this one's arrays (nothing is
+        copied, nor checked again): what a forest's own trees predict with."""
+        if not 0 <= k < self.n_trees:
+            raise IndexError(f"tree {k} of a forest of {self.n_trees} trees")
+        cdef PackedForest one = PackedForest.__new__(PackedForest)
+        cdef intp_t node
+        one._arrays = self._arrays
+        one._view = self._view
+        one._view.tree_offsets = self._view.tree_offsets + k    # its first node, and the end
+        one._view.n_trees = one.n_trees = 1
+        one._types = self._types
+        one.n_outputs = self.n_outputs
+        one.n_types = self.n_types
+        one.n_attributes = self.n_attributes
+        one._dense = self._dense
+        one.n_chains = 0
+        for node in range(self._view.tree_offsets[k], self._view.tree_offsets[k + 1]):
+            one.n_chains += self._view.nodes[node].extra <= -2
+        return one
+
     cdef inline intp_t _position(self, intp_t t) noexcept nogil:
         """Position of type id ``t`` among the forest's types, -1 if it has none."""
         cdef const intp_t* types = self._types

@@ -104,6 +104,10 @@ def main():
                 assert _predictor.predict_mean(forest, data, offsets, out) == (0, -1)
                 leaves = np.empty((n, 3), dtype=np.intp)
                 assert _predictor.apply_leaves(forest, data, offsets, leaves) == (0, -1)
+                for k in range(3):      # each tree alone, on its share of the forest's arrays
+                    alone = np.empty((n, 1), dtype=np.intp)
+                    assert _predictor.apply_leaves(forest.tree(k), data, offsets, alone) == (0, -1)
+                    assert (alone[:, 0] == leaves[:, k]).all()
                 corrupted_inputs(forest, trees, data, offsets)
             assert _rows.scan_rows(data, 3e38, 2**24)[0] == 0, case
     # a feature matrix, read in place whatever its strides: the column splitter

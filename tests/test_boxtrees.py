@@ -270,6 +270,20 @@ def test_side_by_side_runs_the_first_task_in_the_calling_thread_each_on_its_shar
         boxtrees._threads.side_by_side([task] * 3, "test-side", n_threads=2)
 
 
+def test_a_forests_trees_walk_their_share_of_its_pack():
+    X, y = make_box_regression(300, random_state=0)
+    forest = thesis_forest(n_estimators=4, n_tests=50, random_state=0).fit(X, y)
+    assert sum(tree._packed.n_chains for tree in forest.estimators_) == forest._packed.n_chains
+    leaves = forest.apply(X)
+    for k, tree in enumerate(forest.estimators_):
+        alone = pickle.loads(pickle.dumps(tree))    # unpickled: packed on its own
+        np.testing.assert_array_equal(tree.apply(X), leaves[:, k])
+        np.testing.assert_array_equal(tree.predict(X), alone.predict(X))
+    for k in (-1, 4):
+        with pytest.raises(IndexError, match=f"tree {k} of a forest of 4 trees"):
+            forest._packed.tree(k)
+
+
 def test_threads_for_follows_joblib_whatever_it_remembers():
     from joblib import effective_n_jobs, parallel_config
 
