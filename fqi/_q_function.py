@@ -49,8 +49,8 @@ class _QFunction:
                 models.append(previous.models[action])
                 continue
             models.append(_seeded_clone(regressor, rng))
-            fits.append((-mask.sum(), action, partial(_fit_into, models, action,
-                                                      data.states[mask], targets[mask])))
+            fits.append((-mask.sum(), action, partial(_fit_into, models, action, data.states,
+                                                      targets, mask)))
         queue = deque(fit for _, _, fit in sorted(fits, key=lambda fit: fit[:2]))
         side_by_side([partial(_run_all, queue)] * min(threads_for(n_jobs), max(len(fits), 1)),
                      "fqi-actions")
@@ -207,9 +207,10 @@ def _with_actions(states, actions, n_actions):
     return np.hstack([states, onehot])
 
 
-def _fit_into(models, index, X, y):
-    """Fit ``models[index]`` on ``X, y`` and put what its ``fit`` returns in its place."""
-    models[index] = models[index].fit(X, y)
+def _fit_into(models, index, states, targets, mask):
+    """Fit ``models[index]`` on the `states` and `targets` of `mask` (taken here: only the
+    data sets being fitted exist at once) and put what its ``fit`` returns in its place."""
+    models[index] = models[index].fit(states[mask], targets[mask])
 
 
 def _run_all(queue):
