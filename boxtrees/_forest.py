@@ -153,7 +153,7 @@ class _Forest(BaseBoxTrees):
         trees = [self._tree_class(**params, random_state=int(seed)) for seed in seeds]
         self.estimators_ = list(grown) + Parallel(
             n_jobs=self.n_jobs, verbose=self.verbose, prefer="threads"
-        )(delayed(tree._fit)(data, tree.random_state, bootstrap, False) for tree in trees)
+        )(delayed(tree._fit)(data, tree.random_state, bootstrap, pack=False) for tree in trees)
         self._pack(self._trees())
         for k, estimator in enumerate(self.estimators_):    # each walks its share of the pack
             estimator._packed = self._packed.tree(k)

@@ -424,9 +424,8 @@ cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_obje
     Attribute ``c`` of sample ``i``'s objects of type position ``d`` is ``features[c *
     n_objects + type_ptr[i * stride + d]:c * n_objects + type_ptr[i * stride + d + 1]]``, and
     ``positions[k]`` is the type position of object ``k``. Writes the mean leaf value per
-    sample into ``mean`` or,
-    when ``mean`` is NULL, the tree-local leaf ids into the (n_samples, n_trees) ``leaves``;
-    ``mean`` holds ``n_outputs`` values per sample.
+    sample into ``mean`` or, when ``mean`` is NULL, the tree-local leaf ids into the
+    (n_samples, n_trees) ``leaves``; ``mean`` holds ``n_outputs`` values per sample.
     """
     cdef const boxtrees_node* nodes = forest.nodes
     cdef const intp_t* tree_offsets = forest.tree_offsets

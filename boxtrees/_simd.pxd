@@ -20,7 +20,8 @@ cdef extern from "_simd.h":
                             const int32* new_id, int32 mid, coord_t* tmp_x, coord_t* tmp_y,
                             int32* tmp_sid) noexcept nogil
         void (*find_leaves)(const boxtrees_node* nodes, const boxtrees_extra* extras,
-                            const boxtrees_chain* chains, const coord_t* features, intp_t stride, const int32* positions,
+                            const boxtrees_chain* chains, const coord_t* features,
+                            intp_t stride, const int32* positions,
                             const intp_t* types, intp_t types_stride, intp_t n_samples,
                             intp_t* out) noexcept nogil
         int lanes
