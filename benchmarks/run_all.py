@@ -1,6 +1,7 @@
 """Reproduce every experiment of the thesis, with plots and a report, in one command.
 
     python -m benchmarks.run_all --quick --jobs 2 # every experiment, reduced budget, ~7 min
+    python benchmarks/run_all.py --quick --jobs 2 # the same, run as a script
     python -m benchmarks.run_all                  # the thesis's budgets (many hours; resumable)
     python -m benchmarks.run_all --only representations,dqn --out docs/results
     python -m benchmarks.run_all --report-only    # rebuild figures and REPORT.md from the cache
@@ -17,7 +18,18 @@ written, the cluster cannot run the units, or a run was skipped after crashing 3
 report counts it as missing), 130 on Ctrl-C (an interrupt is no crash; finished runs stay
 cached).
 """
-from .reproduce.cli import main
+if __package__:  # python -m benchmarks.run_all, or imported
+    from .reproduce.cli import main
+else:  # python benchmarks/run_all.py: the same main, imported from the package
+    import sys
+    from pathlib import Path
+
+    _ROOT = Path(__file__).resolve().parents[1]
+    if sys.path and Path(sys.path[0] or ".").resolve() == _ROOT / "benchmarks":
+        sys.path[0] = str(_ROOT)  # the script's folder would shadow top-level names
+    else:
+        sys.path.insert(0, str(_ROOT))
+    from benchmarks.run_all import main
 
 if __name__ == "__main__":
     main()
