@@ -1,11 +1,15 @@
 """scikit-learn's estimator checks, run on the real Cython engine.
 
-No expected failures, except one that scikit-learn also expects of its own bootstrapping
-forests (a bootstrap draw on repeated rows is not the draw on weighted rows), and, for the
-forest classifiers, the class weights 1000 : 0.0001 of ``check_class_weight_classifiers``:
-scikit-learn's own forests pass it only with the ``min_weight_fraction_leaf=0.01`` the check
-sets, which the box trees do not have (``ExtraTreesClassifier`` without it predicts the heavy
-class for 42-46% of the check's samples, where it asks for 87%).
+The expected failures are strict (a check that passes fails the test, so the list stays
+true): the one scikit-learn also expects of its own bootstrapping forests (a bootstrap draw
+on repeated rows is not the draw on weighted rows), and, for the forest classifiers with
+``"random"`` or ``"classic"`` tests, the class weights 1000 : 0.0001 of
+``check_class_weight_classifiers``. Their splits cut leaves holding only the nearly
+weightless classes, which predict them: 48-82% of the check's samples get the heavy class
+(``"random"``) and 78-94% (``"classic"``), where it asks for more than 87% (scikit-learn's
+own forests pass it only with the ``min_weight_fraction_leaf=0.01`` the check sets, which
+the box trees do not have). With ``"fixed"`` and ``"bounded"`` tests (boxes of a set width)
+the forests give the heavy class to 90-100% of them, and pass.
 """
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
@@ -36,13 +40,13 @@ def expected_failures(estimator):
     if getattr(estimator, "bootstrap", False):
         failures["check_sample_weight_equivalence_on_dense_data"] = \
             "a bootstrap sample of repeated rows differs from one of weighted rows"
-    if "class_weight" in estimator.get_params():
+    if "class_weight" in estimator.get_params() and estimator.test_type in ("random", "classic"):
         failures["check_class_weight_classifiers"] = \
-            "leaves holding only the nearly weightless classes predict them (no " \
-            "min_weight_fraction_leaf)"
+            "splits cut leaves holding only the nearly weightless classes, which predict them " \
+            "(no min_weight_fraction_leaf)"
     return failures
 
 
-@parametrize_with_checks(ESTIMATORS, expected_failed_checks=expected_failures)
+@parametrize_with_checks(ESTIMATORS, expected_failed_checks=expected_failures, xfail_strict=True)
 def test_sklearn_compatible(estimator, check):
     check(estimator)
