@@ -86,6 +86,12 @@ class BaseBoxTrees(ObjectInputMixin, BaseEstimator):
         kept = sample_weight > 0
         if not kept.all():
             sets, y, sample_weight = sets[kept], y[kept], sample_weight[kept]
+        if not self._fitted_on_features and not sets.n_objects:
+            warnings.warn("X holds no object (every set of positive weight is empty), so "
+                          "there is no object to test and every tree is a single leaf, "
+                          "predicting the mean target whatever the sets; check that the sets "
+                          "hold their objects as rows [f_1, ..., f_d, type]",
+                          UserWarning, stacklevel=4)
         if len(sets) > _INT32_MAX - 1:
             raise ValueError(f"at most {_INT32_MAX - 1} samples are supported, got {len(sets)}")
         with np.errstate(over="ignore"):

@@ -158,7 +158,12 @@ class _SingleTree(BaseBoxTrees):
     @property
     def feature_importances_(self) -> np.ndarray:
         """Impurity-based importance of each type of ``types_`` (each column for a feature
-        matrix), summing to 1 (all zeros for a single leaf), shape (``n_types_``,)."""
+        matrix), summing to 1 (all zeros for a single leaf), shape (``n_types_``,).
+
+        On held-out object sets, `type_importance` measures the loss of score without each
+        type: the set counterpart of scikit-learn's ``permutation_importance``, which
+        permutes the columns of a feature matrix and refuses object sets.
+        """
         check_is_fitted(self)
         return self.tree_.type_importances(self.types_)
 

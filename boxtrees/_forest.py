@@ -268,6 +268,12 @@ class _Forest(BaseBoxTrees):
         matrix): the weighted variance reduction of the tests on it, normalised per tree,
         averaged over trees, summing to 1 (all zeros if no tree splits).
 
+        Computed from the training data, it says what the trees split on, not what
+        predicts well on new data: on held-out object sets, `type_importance` (and
+        `region_importance`) measure the loss of score without each type, the set
+        counterparts of scikit-learn's ``permutation_importance`` (which permutes the
+        columns of a feature matrix, and refuses object sets).
+
         Returns
         -------
         importances : ndarray of shape (``n_types_``,)
@@ -411,7 +417,8 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
     type_names_ : ndarray
         The label of each type id (``type_names_[t]`` names id ``t``), when fitted on
         object sets whose types are named (`ObjectSets.from_frame`); a batch whose types are
-        named is read by name at predict.
+        named is read by name at predict. Names on one side only (at fit or at predict)
+        warn, as scikit-learn's feature names do: the type ids are then read as they are.
     n_attributes_ : int
         Number of attributes ``d`` of the objects seen at fit (1 for a feature matrix).
     column_groups_ : tuple of tuple of int
@@ -433,7 +440,8 @@ class BoxExtraTreesRegressor(RegressionTargets, _Forest):
     BoxExtraTreeRegressor : one tree of the forest.
     GridCounts : the fixed-size grid representation, for any scikit-learn regressor.
     type_importance, region_importance : what the objects of each type, and of each region,
-        bring to the score.
+        bring to the score (scikit-learn's ``permutation_importance`` reads ``X`` as a
+        feature matrix).
     sklearn.ensemble.ExtraTreesRegressor : classic Extra-Trees on feature matrices.
 
     Examples

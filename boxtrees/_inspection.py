@@ -39,7 +39,8 @@ class _Predictor(Protocol):
 
 class _Scores:
     """The estimator's score on batches of the object sets of ``X`` (``sets``), and on
-    ``X`` itself (``baseline``)."""
+    ``X`` itself (``baseline``); ``type_names``, the name of each of ``types``, from the
+    names of ``X`` or else those the estimator was fitted with (None when unnamed)."""
 
     def __init__(self, estimator, X, y, types, scoring, sample_weight):
         if is_feature_matrix(X):
@@ -55,6 +56,11 @@ class _Scores:
         if absent.size:
             raise ValueError(f"types {absent.tolist()} have no object in X (its types: "
                              f"{present.tolist()})")
+        names = self.sets.type_names
+        if names is None:
+            names = getattr(estimator, "type_names_", None)
+        self.type_names = (names[self.types] if names is not None
+                           and self.types.max() < len(names) else None)
         self._score = check_scoring(estimator, scoring=scoring)
         self._estimator, self._y = estimator, y
         self._weight = {} if sample_weight is None else {"sample_weight": sample_weight}
@@ -72,8 +78,11 @@ class _Scores:
                                    self.sets.type_names)
 
     def importances(self, drops, **fields):
-        """The Bunch of score ``drops`` (repeats along the last axis), with ``fields``."""
+        """The Bunch of score ``drops`` (repeats along the last axis), with ``fields``, and
+        ``type_names`` when the types are named."""
         drops = np.asarray(drops, dtype=np.float64)
+        if self.type_names is not None:
+            fields["type_names"] = self.type_names
         return Bunch(importances_mean=drops.mean(axis=-1), importances_std=drops.std(axis=-1),
                      importances=drops, baseline_score=self.baseline, types=self.types, **fields)
 
@@ -127,7 +136,9 @@ def type_importance(estimator: _Predictor, X: ObjectSetsInput, y: ArrayLike, *,
         ``importances_mean``, ``importances_std`` of shape (n_types,) and ``importances`` of
         shape (n_types, n_repeats) (``(n_types, 1)`` for ``"drop"``): the baseline score
         minus the score with the type's objects shuffled or removed; ``baseline_score``;
-        ``types``, the type id of each row.
+        ``types``, the type id of each row; ``type_names``, the name of each row, when the
+        types are named (by ``X``'s ``type_names``, or else by the estimator's
+        ``type_names_``).
 
     Raises
     ------
@@ -231,7 +242,8 @@ def region_importance(estimator: _Predictor, X: ObjectSetsInput, y: ArrayLike, *
         ``y_edges[j]`` to ``y_edges[j + 1]``; ``(n_types, n_bins, 1)`` for ``d = 1``) and
         ``importances`` with the repeats along a last axis; ``counts``, the objects of each
         type in each cell, summed over the samples; ``x_edges``, ``y_edges``;
-        ``baseline_score``; ``types``.
+        ``baseline_score``; ``types``; ``type_names`` when the types are named (as in
+        `type_importance`).
 
     Raises
     ------

@@ -167,6 +167,10 @@ class ObjectSets:
     ----------
     data, offsets, type_names
         As given (validated).
+    shape : tuple of int
+        ``(n_sets,)``: a batch is indexed along its sets, as a 1D array of them (which
+        scikit-learn's splitters and ``_safe_indexing`` read, and index with
+        ``sets[indices, ...]``, keeping the batch and its ``type_names``).
 
     Examples
     --------
@@ -177,23 +181,28 @@ class ObjectSets:
     (2, [1, 0], 2)
     """
 
-    __slots__ = ("data", "offsets", "type_names")
+    # _present_only: made by `from_frame` without ``samples``, so of the samples with objects
+    # only (a sample without objects has no row); the batch's parts and joins keep it
+    __slots__ = ("data", "offsets", "type_names", "_present_only")
     data: np.ndarray
     offsets: np.ndarray
     type_names: np.ndarray | None
+    _present_only: bool
 
     def __init__(self, data: ArrayLike, offsets: ArrayLike,
                  type_names: ArrayLike | None = None) -> None:
         self.data = _check_rows(data)
         self.offsets = _check_offsets(offsets, len(self.data))
         self.type_names = _check_type_names(type_names, self.data)
+        self._present_only = False
 
     @classmethod
     def _trusted(cls, data: np.ndarray, offsets: np.ndarray,
-                 type_names: np.ndarray | None = None) -> Self:
+                 type_names: np.ndarray | None = None, present_only: bool = False) -> Self:
         """Wrap arrays that are already valid (internal: no checks, no copies)."""
         self = cls.__new__(cls)
         self.data, self.offsets, self.type_names = data, offsets, type_names
+        self._present_only = present_only
         return self
 
     @classmethod
@@ -216,7 +225,9 @@ class ObjectSets:
             ``>= 0`` are type ids themselves.
         samples : array-like, default=None
             Every sample id, in the order of the sets: samples without objects become empty
-            sets (a group-by drops them). None: the ids present, sorted.
+            sets (a group-by drops them). None: the ids present, sorted; a sample without
+            objects has no row, and so no set (fitting on the batch with the targets of all
+            the samples then says so).
 
         Returns
         -------
@@ -283,7 +294,9 @@ class ObjectSets:
         rows = np.argsort(set_of, kind="stable")        # objects in set order, then row order
         data = np.column_stack([attributes, np.asarray(ids, dtype=np.float64)])[rows]
         sizes = np.bincount(set_of, minlength=len(known))
-        return cls(data.reshape(-1, len(columns) + 1), _offsets_from_sizes(sizes), type_names)
+        sets = cls(data.reshape(-1, len(columns) + 1), _offsets_from_sizes(sizes), type_names)
+        sets._present_only = samples is None
+        return sets
 
     @classmethod
     def from_sequence(cls, sets: Sequence[ArrayLike]) -> Self:
@@ -494,7 +507,7 @@ class ObjectSets:
             raise ValueError("the batches of ObjectSets.concatenate must name their types alike "
                              "(the same type_names, or none)")
         return cls._trusted(np.concatenate(data), _offsets_from_sizes(np.concatenate(sizes)),
-                            names)
+                            names, any(batch._present_only for batch in batches))
 
     def __len__(self) -> int:
         return len(self.offsets) - 1
@@ -526,7 +539,10 @@ class ObjectSets:
 
     def __getitem__(self, index):
         """``sets[i]`` is the ``(n_i, d + 1)`` array of set ``i`` (a view); slices, integer arrays
-        and boolean masks give a new ``ObjectSets``."""
+        and boolean masks give a new ``ObjectSets``, with the same ``type_names``. An index
+        may be followed by an ellipsis, ``sets[index, ...]``, as for a 1D array of sets."""
+        if isinstance(index, tuple) and len(index) == 2 and index[1] is Ellipsis:
+            index = index[0]
         if isinstance(index, Integral):
             n = len(self)
             if not -n <= index < n:
@@ -539,7 +555,7 @@ class ObjectSets:
                 stop = max(start, stop)
                 offsets = self.offsets[start : stop + 1]
                 return ObjectSets._trusted(self.data[offsets[0] : offsets[-1]], offsets - offsets[0],
-                                           self.type_names)
+                                           self.type_names, self._present_only)
             index = np.arange(start, stop, step)
         index = np.asarray(index)
         if index.dtype == bool:
@@ -554,7 +570,7 @@ class ObjectSets:
         starts, sizes = self.offsets[index], self.sizes[index]
         offsets = _offsets_from_sizes(sizes)
         rows = np.repeat(starts - offsets[:-1], sizes) + np.arange(offsets[-1])
-        return ObjectSets._trusted(self.data[rows], offsets, self.type_names)
+        return ObjectSets._trusted(self.data[rows], offsets, self.type_names, self._present_only)
 
     def __iter__(self) -> Iterator[np.ndarray]:
         for i in range(len(self)):
@@ -575,12 +591,19 @@ class ObjectSets:
             "boxtrees.region_importance measure what the objects of each type, and of each "
             "region, bring to a score")
 
+    @property
+    def shape(self) -> tuple[int]:
+        """``(n_sets,)``: the batch's length, as the shape of a 1D array of sets."""
+        return (len(self),)
+
     def __getstate__(self) -> dict[str, Any]:
-        return {"data": self.data, "offsets": self.offsets, "type_names": self.type_names}
+        return {"data": self.data, "offsets": self.offsets, "type_names": self.type_names,
+                "present_only": self._present_only}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.data, self.offsets = state["data"], state["offsets"]
         self.type_names = state.get("type_names")
+        self._present_only = state.get("present_only", False)
 
 
 def _is_ragged_batch(X):
@@ -608,6 +631,35 @@ def _is_sequence_of_items(X):
     if isinstance(X, (list, tuple)):
         return True
     return getattr(X, "ndim", None) == 1 and getattr(X, "dtype", None) == object
+
+
+def _no_samples_error(estimator):
+    """The ValueError for an ``X`` with no sample, saying what a sample is."""
+    return ValueError(
+        f"X is empty (0 samples), but {type(estimator).__name__} needs at least one: a sample "
+        f"is a set of objects, an array of shape (n_objects, d + 1) of rows [f_1, ..., f_d, "
+        f"type] (a set may be empty, the batch may not), or a row of a feature matrix")
+
+
+def _long_table_error(X, n_targets, error):
+    """The ValueError for a data frame ``X`` that failed to read as a feature matrix
+    (``error``) and looks like a long table of objects, one row per object: columns that do
+    not hold numbers, or more rows than the ``n_targets`` (None: unknown). None for any
+    other ``X``."""
+    if not hasattr(X, "columns") or not hasattr(X, "__getitem__"):
+        return None
+    other = [name for name in X.columns if np.asarray(X[name]).dtype.kind not in "biuf"]
+    if other:
+        reason = f"its columns {other} do not hold numbers"
+    elif n_targets is not None and len(X) > n_targets:
+        reason = f"it has {len(X)} rows for {n_targets} targets"
+    else:
+        return None
+    return ValueError(
+        f"X is a data frame, read as a feature matrix (one row per sample), but {reason} "
+        f"({error}). If X is a long table of objects (one row per object), build the sets "
+        f"with ObjectSets.from_frame(X, sample=<sample column>, columns=[<attribute columns>], "
+        f"type=<type column>, samples=<every sample id, in the order of y>)")
 
 
 def is_feature_matrix(X):
@@ -699,14 +751,23 @@ class ObjectInputMixin:
 
     def _named_as_fitted(self, sets):
         """``sets`` with its type ids read through its type names into the ids of the names
-        seen at fit (a name not seen at fit gets an id no test reads)."""
+        seen at fit (a name not seen at fit gets an id no test reads).
+
+        Names on one side only warn, as scikit-learn's feature names do: the ids are then
+        read as they are, which is right only if they are numbered as at fit.
+        """
         fitted = getattr(self, "type_names_", None)
-        if sets.type_names is None:
-            return sets
-        if fitted is None:
-            raise ValueError(f"X names its types (type_names), but {type(self).__name__} was "
-                             f"fitted on unnamed type ids; pass type ids as at fit")
-        if _same_names(sets.type_names, fitted):
+        if (sets.type_names is None) != (fitted is None):
+            has, was, read = (
+                ("does not have", "with", "its type id t is read as the type named "
+                 "type_names_[t]") if fitted is not None else
+                ("has", "without", "its type ids are read as the ids seen at fit, and its "
+                 "names ignored"))
+            warnings.warn(f"X {has} type names, but {type(self).__name__} was fitted {was} "
+                          f"type names: {read}. Name the types of both (ObjectSets.from_frame, "
+                          f"or ObjectSets with type_names) to have them read by name",
+                          UserWarning)
+        if sets.type_names is None or fitted is None or _same_names(sets.type_names, fitted):
             return sets
         ids = {name: i for i, name in enumerate(fitted.tolist())}
         table = np.array([ids.get(name, len(fitted)) for name in sets.type_names.tolist()],
@@ -724,6 +785,8 @@ class ObjectInputMixin:
         if requires_y and issparse(y):
             raise TypeError(f"sparse targets are not supported: y is a {type(y).__name__}; "
                             f"pass a dense array (y.toarray())")
+        if (isinstance(X, (list, tuple)) or getattr(X, "ndim", None) == 1) and not len(X):
+            raise _no_samples_error(self)
         dense = is_feature_matrix(X)
         if not reset:
             fitted_dense = self._fitted_on_features
@@ -731,7 +794,8 @@ class ObjectInputMixin:
                 raise ValueError(
                     f"{type(self).__name__} was fitted on object sets, but X is read as a 2D "
                     f"feature matrix; pass a sequence of (n_i, d + 1) arrays or an ObjectSets "
-                    f"(a single object set must be wrapped in a list)"
+                    f"(ObjectSets.from_frame reads a long table, one row per object; a single "
+                    f"object set must be wrapped in a list)"
                 )
             if not dense and fitted_dense:
                 raise ValueError(
@@ -739,11 +803,18 @@ class ObjectInputMixin:
                     f"{self.n_features_in_} features, but X holds object sets"
                 )
         if dense:
-            if requires_y:
-                X, y = validate_data(self, X, y, reset=reset, dtype=np.float32,
-                                     multi_output=True, y_numeric=self._y_numeric)
-            else:
-                X = validate_data(self, X, reset=reset, dtype=np.float32)
+            try:
+                if requires_y:
+                    X, y = validate_data(self, X, y, reset=reset, dtype=np.float32,
+                                         multi_output=True, y_numeric=self._y_numeric)
+                else:
+                    X = validate_data(self, X, reset=reset, dtype=np.float32)
+            except ValueError as error:
+                long_table = _long_table_error(X, len(y) if hasattr(y, "__len__") else None,
+                                               error)
+                if long_table is None:
+                    raise
+                raise long_table from error
             sets = X if matrix else ObjectSets._from_validated_features(X)
             n_attributes = 1
         else:
@@ -753,7 +824,7 @@ class ObjectInputMixin:
                 for attr in ("n_features_in_", "feature_names_in_"):
                     self.__dict__.pop(attr, None)
                 if len(sets) == 0:
-                    raise ValueError("X has no samples; at least one sample is required")
+                    raise _no_samples_error(self)
             elif n_attributes != self.n_attributes_:
                 if sets.n_objects:
                     raise ValueError(
@@ -762,7 +833,8 @@ class ObjectInputMixin:
                         f"{self.n_attributes_ + 1} columns ([f_1, ..., f_d, type], d = "
                         f"{self.n_attributes_})")
                 n_attributes = self.n_attributes_   # no object: nothing to read
-                sets = ObjectSets._trusted(sets.data.reshape(0, n_attributes + 1), sets.offsets)
+                sets = ObjectSets._trusted(sets.data.reshape(0, n_attributes + 1), sets.offsets,
+                                           sets.type_names)
             if requires_y:
                 if y is None:
                     raise ValueError(f"{type(self).__name__} requires y to be passed, but the target y is None")
@@ -779,5 +851,11 @@ class ObjectInputMixin:
         if requires_y:
             y = _check_targets(y)
             if len(y) != len(sets):
-                raise ValueError(f"X has {len(sets)} samples but y has {len(y)}")
+                dropped = ""
+                if isinstance(X, ObjectSets) and X._present_only and len(X) < len(y):
+                    dropped = ("; X was built by ObjectSets.from_frame without samples, so the "
+                               "samples without objects (no row in the frame) have no set: pass "
+                               "samples=<every sample id, in the order of y> to give them empty "
+                               "sets")
+                raise ValueError(f"X has {len(sets)} samples but y has {len(y)}{dropped}")
         return sets, y

@@ -35,7 +35,7 @@ def small_forest(**params):
         (GOOD, [1.0, np.nan, 2.0], ValueError, "NaN"),
         (GOOD, [1.0, np.inf, 2.0], ValueError, "infinity"),
         (GOOD, None, ValueError, "requires y"),
-        (ObjectSets.from_sequence([]), [], ValueError, "no samples"),
+        (ObjectSets.from_sequence([]), [], ValueError, r"X is empty \(0 samples\)"),
         (np.empty((0, 3)), [], ValueError, "0 sample"),
         (np.array([[np.nan, 1.0]]), [1.0], ValueError, "NaN"),
     ],
@@ -169,6 +169,7 @@ def object_sets(draw, max_sets=12, max_objects=6, max_type=6):
     return sets
 
 
+@pytest.mark.filterwarnings("ignore:X holds no object")
 @settings(max_examples=150, deadline=None)
 @given(
     train=object_sets(max_type=3),
@@ -198,6 +199,7 @@ def test_fuzz_valid_inputs_never_crash_and_predict_within_target_range(train, te
             GridCounts(3).fit(train)
 
 
+@pytest.mark.filterwarnings("ignore:X holds no object")
 @settings(max_examples=150, deadline=None)
 @given(
     raw=st.lists(

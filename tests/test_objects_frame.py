@@ -80,11 +80,13 @@ def test_the_estimators_learn_from_frames_and_read_new_frames_by_type_name():
     np.testing.assert_array_equal(forest[0].predict(X_renamed), forest[0].predict(without))
     again = pickle.loads(pickle.dumps(forest))
     np.testing.assert_array_equal(again.predict(X_renamed), forest.predict(X_renamed))
-    # named types at predict need names at fit
+    # named types at predict, unnamed at fit: the ids are read as they are, with a warning
     plain = BoxExtraTreesClassifier(5, random_state=0).fit(
         ObjectSets(X.data, X.offsets), y > 0)
-    with pytest.raises(ValueError, match="X names its types"):
-        plain.predict(X_test)
+    with pytest.warns(UserWarning, match="X has type names, but BoxExtraTreesClassifier was "
+                                         "fitted without type names"):
+        named = plain.predict(X_test)
+    np.testing.assert_array_equal(named, plain.predict(ObjectSets(X_test.data, X_test.offsets)))
     assert GridCounts(4).fit(X).transform(X_renamed).shape == (200, 4 * 4 * 3)
 
 
