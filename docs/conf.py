@@ -6,11 +6,14 @@ Build from the repository's root::
 
     python -m sphinx -b html docs docs/_build/html
 """
+import ast
 import re
 import sys
 from pathlib import Path
 
 import matplotlib
+from sphinx.errors import PycodeError
+from sphinx.pycode import ModuleAnalyzer
 
 matplotlib.use("Agg")
 
@@ -132,6 +135,51 @@ def _anchors_as_targets(app, docname, source):
         source[0] = _ANCHOR.sub(r"(\1)=", source[0])
 
 
+def _definitions(body, prefix=""):
+    """The functions and classes of a module's `body` (methods too, as ``Class.name``) as
+    viewcode's tags: ``{name: ("def" | "class", first line, last line)}``, the first line that
+    of the first decorator."""
+    tags = {}
+    for node in body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            name = prefix + node.name
+            start = min([node.lineno] + [d.lineno for d in node.decorator_list])
+            is_class = isinstance(node, ast.ClassDef)
+            tags[name] = ("class" if is_class else "def", start, node.end_lineno)
+            if is_class:
+                tags.update(_definitions(node.body, name + "."))
+    return tags
+
+
+_SOURCES = {}
+
+
+def _source_and_tags(app, modname):
+    """viewcode's source and tags of one of our modules that Sphinx's own module parser
+    cannot read; None for any other (viewcode reads it itself).
+
+    Sphinx 9.0's parser unparses each decorator and fails on a dict display holding
+    ``**mapping`` (``sphinx.pycode.ast``: "zip() argument 2 is longer than argument 1"), as
+    in ``@validate_params({**_COMMON, ...})`` of ``boxtrees/_inspection.py``; viewcode then
+    drops the module: no [source] link for ``type_importance`` and ``region_importance``,
+    and no ``_modules/boxtrees/_inspection.html``. Python's own parser reads it.
+    """
+    if modname.split(".")[0] not in _OWN:
+        return None
+    if modname not in _SOURCES:
+        try:
+            ModuleAnalyzer.for_module(modname).find_tags()
+            _SOURCES[modname] = None
+        except PycodeError:
+            try:
+                _, code = ModuleAnalyzer.get_module_source(modname)
+                _SOURCES[modname] = code, _definitions(ast.parse(code).body)
+            except (PycodeError, SyntaxError):
+                _SOURCES[modname] = None
+    return _SOURCES[modname]
+
+
 def setup(app):
     app.connect("autodoc-skip-member", _skip_foreign_members)
     app.connect("source-read", _anchors_as_targets)
+    app.connect("viewcode-find-source", _source_and_tags)
