@@ -1,16 +1,17 @@
 """Long-lived thread pools, one per purpose and size, started on first use and forgotten in
 a forked child (whose parent's threads are gone); tasks run side by side in the calling
-thread and a pool's; and the share of the cores a call made from one of those threads may
-use."""
+thread and a pool's, each under the calling thread's scikit-learn configuration; and the
+share of the cores a call made from one of those threads may use."""
 import os
 import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor, wait
-from functools import lru_cache
+from functools import lru_cache, partial
 from typing import TypeVar
 
 from joblib import effective_n_jobs
 from joblib.parallel import get_active_backend
+from sklearn import config_context, get_config
 
 __all__ = ["side_by_side", "thread_pool", "threads_for"]
 
@@ -75,7 +76,8 @@ def side_by_side(tasks: Sequence[Callable[[], T]], purpose: str,
     """The results of the callables `tasks`, run side by side on `n_threads` threads: the
     first task in the calling thread (which would otherwise only wait), each other one in a
     thread of the pool of `purpose` of ``n_threads - 1`` threads (`thread_pool`); each runs
-    as one of `n_threads` siblings (`threads_for`).
+    as one of `n_threads` siblings (`threads_for`), under the calling thread's scikit-learn
+    configuration (``sklearn.get_config()``, which belongs to a thread).
 
     Returns only when every task has finished, even when one failed (the first failure is
     then raised): no task outlives the call, so none writes into what the caller frees.
@@ -107,9 +109,10 @@ def side_by_side(tasks: Sequence[Callable[[], T]], purpose: str,
         return [tasks[0]()]
     pool, others = thread_pool(n_threads - 1, purpose), []
     outside = getattr(_LOCAL, "siblings", None)
+    config = get_config()
     try:
         for task in tasks[1:]:      # one by one: a failed submit still waits for the others
-            others.append(pool.submit(task))
+            others.append(pool.submit(partial(_configured, config, task)))
         _LOCAL.siblings = n_threads
         first = tasks[0]()
     finally:
@@ -119,6 +122,12 @@ def side_by_side(tasks: Sequence[Callable[[], T]], purpose: str,
             _LOCAL.siblings = outside
         wait(others)
     return [first] + [future.result() for future in others]
+
+
+def _configured(config, task):
+    """``task()`` under the scikit-learn configuration `config`."""
+    with config_context(**config):
+        return task()
 
 
 def threads_for(n_jobs: int | None) -> int:

@@ -1,4 +1,5 @@
 """Rollouts on a gymnasium vector env, and the transitions they produce."""
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -7,6 +8,10 @@ from gymnasium.vector import AutoresetMode
 from ._envs import _TRAINING_SEED_END, _autoreset_mode, _checked_step, _seeded_reset
 
 __all__ = []
+
+# The training episodes whose mean return is reported (stable-baselines3's
+# ``stats_window_size``).
+_EPISODES_KEPT = 100
 
 
 @dataclass
@@ -70,6 +75,12 @@ class _Collector:
         self._rng = rng
         self._obs = None
         self._resetting = None  # NEXT_STEP: the envs whose next step is a reset
+        self._returns = np.zeros(env.num_envs)  # of each env's episode so far
+        self._ended = deque(maxlen=_EPISODES_KEPT)  # returns of the last episodes that ended
+
+    def mean_episode_return(self):
+        """Mean undiscounted return of the last 100 episodes that ended (NaN before one)."""
+        return float(np.mean(self._ended)) if self._ended else np.nan
 
     def collect(self, n_samples, policy, q_values=None):
         """Record the first `n_samples` transitions of the steps it takes to get them.
@@ -101,6 +112,7 @@ class _Collector:
                 seeds = self._rng.integers(_TRAINING_SEED_END, size=n_envs).tolist()
                 self._obs = self.observations.batch(_seeded_reset(self.env, seeds))
                 self._resetting = np.zeros(n_envs, dtype=bool)
+                self._returns[:] = 0.0
             obs, live = self._obs, ~self._resetting
             everyone = live.all()
             q = None
@@ -135,6 +147,10 @@ class _Collector:
         rewards, terminated, truncated = _checked_step(rewards, terminated, truncated,
                                                        self.env.num_envs)
         ended = terminated | truncated
+        live = ~self._resetting if self.mode is AutoresetMode.NEXT_STEP else slice(None)
+        self._returns[live] += rewards[live]
+        self._ended.extend(self._returns[ended])
+        self._returns[ended] = 0.0
         self._obs = self.observations.batch(obs)
         next_obs = self._obs
         if self.mode is AutoresetMode.NEXT_STEP:

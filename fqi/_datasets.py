@@ -70,8 +70,10 @@ def _dataset_transitions(dataset, observations, observation_space, action_space)
 def _observations(columns, key, observations):
     """``columns[key]`` as a batch in the agent's format."""
     try:
-        return observations.batch(columns[key])
+        return observations.batch(columns[key], f"the dataset's {key} are a batch")
     except (TypeError, ValueError) as error:
+        if "the dataset's" in str(error):
+            raise
         raise type(error)(f"the dataset's {key}: {error}") from None
 
 

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,6 +17,9 @@ from ._typing import EnvLike, Observation, Policy
 __all__ = ["evaluate", "Evaluation", "RandomPolicy"]
 
 _DEFAULT_EPISODES = 10
+# The steps an episode may last when the env states no time limit (its spec's
+# ``max_episode_steps``): an episode that never ends must not hang an evaluation.
+_STEP_CAP = 1_000
 
 
 @dataclass(frozen=True)
@@ -45,16 +49,17 @@ class Evaluation:
 
 
 def _eval_seeds(n_episodes: int | None, seeds: Sequence[int] | None, name: str = "n_episodes",
-                seeds_name: str = "seeds") -> tuple[int, ...]:
+                seeds_name: str = "seeds", default: int = _DEFAULT_EPISODES
+                ) -> tuple[int, ...]:
     """The reset seeds of an evaluation: `seeds` (checked, and `n_episodes` of them when
-    both are given), else ``2**40, 2**40 + 1, ...``, `n_episodes` of them (default 10);
-    none for ``n_episodes=0``."""
+    both are given), else ``2**40, 2**40 + 1, ...``, `n_episodes` of them (`default` when
+    it is None); none for ``n_episodes=0``."""
     if n_episodes is not None:
         n_episodes = _check_int(name, n_episodes, 0)
         if n_episodes == 0:
             return ()
     if seeds is None:
-        n = _DEFAULT_EPISODES if n_episodes is None else n_episodes
+        n = default if n_episodes is None else n_episodes
         return tuple(range(_TRAINING_SEED_END, _TRAINING_SEED_END + n))
     if isinstance(seeds, (str, bytes)) or not hasattr(seeds, "__len__"):
         raise TypeError(f"{seeds_name} must be a sequence of ints, got {seeds!r}")
@@ -116,13 +121,14 @@ class RandomPolicy:
 
 
 def evaluate(policy: Policy, env: EnvLike, n_episodes: int | None = None,
-             seeds: Sequence[int] | None = None) -> Evaluation:
+             seeds: Sequence[int] | None = None,
+             max_episode_steps: int | None = None) -> Evaluation:
     """Play one episode per reset seed with the policy's greedy actions.
 
     The episodes run side by side on a vector env (one env per episode; a given
     `gymnasium.vector.VectorEnv` plays them in rounds of its size), each reset with its
-    own seed and played until it terminates or is truncated. Nothing else is random, so the
-    same policy scores the same. The thesis's evaluation is ``seeds=envs.reference_worlds(
+    own seed and played until it terminates, is truncated, or reaches `max_episode_steps`.
+    Nothing else is random, so the same policy scores the same. The thesis's evaluation is ``seeds=envs.reference_worlds(
     400)`` on ObjectWorld: 400 episodes of 50 steps, 20,000 steps, scored by ``total``.
 
     Parameters
@@ -133,8 +139,8 @@ def evaluate(policy: Policy, env: EnvLike, n_episodes: int | None = None,
         stable-baselines3 model on a ``Box`` env): one int action in ``[0, n_actions)`` per
         env (else a ValueError).
     env : str, gymnasium.Env, gymnasium.vector.VectorEnv or callable
-        As for `FQI`. Its episodes must end (a time limit). A vector env is played as it is
-        and left open; the vector env built from any other form is closed at the end.
+        As for `FQI`. A vector env is played as it is and left open; the vector env built
+        from any other form is closed at the end.
     n_episodes : int, default=None
         Number of episodes: ``len(seeds)`` when seeds are given, else 10.
     seeds : sequence of int, default=None
@@ -144,6 +150,11 @@ def evaluate(policy: Policy, env: EnvLike, n_episodes: int | None = None,
         behind ``"CartPole-v1"``) is reset with ``seeds[0]``: its episodes are then fixed
         by that seed and their number, not by one seed each (use
         ``gymnasium.make_vec(id, n, vectorization_mode="sync")`` for per-episode seeds).
+    max_episode_steps : int, default=None
+        Steps after which an episode is ended and scored as it stands. None: the env's time
+        limit (its spec's ``max_episode_steps``) when it states one, else 1,000 steps, with
+        a warning when an episode reaches them (an env whose episodes never end would
+        otherwise be played forever: wrap it in ``gymnasium.wrappers.TimeLimit``).
 
     Returns
     -------
@@ -167,25 +178,49 @@ def evaluate(policy: Policy, env: EnvLike, n_episodes: int | None = None,
     seeds = _eval_seeds(n_episodes, seeds)
     if not seeds:
         raise ValueError("n_episodes must be >= 1 (or give at least one seed)")
+    if max_episode_steps is not None:
+        max_episode_steps = _check_int("max_episode_steps", max_episode_steps, 1)
     vector = _make_vector(env, len(seeds))
     returns_by_round, lengths_by_round = [], []
     try:
         n_actions = _n_actions(vector.single_action_space)
+        limit = _time_limit(vector)
+        cap = max_episode_steps or limit or _STEP_CAP
         for start in range(0, len(seeds), vector.num_envs):
             round_returns, round_lengths = _play_round(policy, vector, n_actions,
-                                                       seeds[start:start + vector.num_envs])
+                                                       seeds[start:start + vector.num_envs],
+                                                       cap)
             returns_by_round.append(round_returns)
             lengths_by_round.append(round_lengths)
     finally:
         _close_built(vector, env)
     returns, lengths = np.concatenate(returns_by_round), np.concatenate(lengths_by_round)
+    if max_episode_steps is None and limit is None and (lengths >= cap).any():
+        warnings.warn(f"{(lengths >= cap).sum()} of {len(seeds)} evaluation episodes reached "
+                      f"{cap:,} steps without ending and were ended there; the env states no "
+                      f"time limit: wrap it in gymnasium.wrappers.TimeLimit (for FQI, as env "
+                      f"or eval_env), or pass max_episode_steps to fqi.evaluate",
+                      RuntimeWarning, stacklevel=2)
     return Evaluation(float(returns.sum()), float(returns.mean()), float(returns.std()),
                       returns, lengths, seeds)
 
 
-def _play_round(policy, vector, n_actions, seeds):
+def _time_limit(vector):
+    """The ``max_episode_steps`` of the spec of `vector` or of its first env; None when
+    neither states one."""
+    specs = [getattr(vector, "spec", None)]
+    envs = getattr(vector, "envs", None)
+    if envs:
+        specs.append(getattr(envs[0], "spec", None))
+    limits = [spec.max_episode_steps for spec in specs
+              if spec is not None and spec.max_episode_steps is not None]
+    return limits[0] if limits else None
+
+
+def _play_round(policy, vector, n_actions, seeds, cap):
     """Returns and lengths of one episode per seed, on the first ``len(seeds)`` envs of
-    `vector` (the others replay the same seeds and are not counted)."""
+    `vector` (the others replay the same seeds and are not counted), each ended after at
+    most `cap` steps."""
     n_envs = vector.num_envs
     obs = _seeded_reset(vector, (list(seeds) * n_envs)[:n_envs])
     mode = _autoreset_mode(vector)
@@ -197,7 +232,7 @@ def _play_round(policy, vector, n_actions, seeds):
         obs, rewards, terminated, truncated, _ = vector.step(actions)
         returns[playing] += np.asarray(rewards, dtype=np.float64)[playing]
         lengths[playing] += 1
-        ended = playing & (np.asarray(terminated) | np.asarray(truncated))
+        ended = playing & (np.asarray(terminated) | np.asarray(truncated) | (lengths >= cap))
         playing &= ~ended
         if ended.any() and mode is AutoresetMode.DISABLED:
             obs, _ = vector.reset(options={"reset_mask": ended})

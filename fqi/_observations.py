@@ -41,13 +41,10 @@ class _FeatureRows:
         self.dtype = np.float64 if space.dtype == np.float64 else np.float32
         self.n_features = int(np.prod(space.shape))
 
-    def batch(self, obs):
-        """A vector env's batched observations as a new matrix, checked to be finite."""
-        matrix = self._matrix(np.array(obs, dtype=self.dtype), batch=True)
-        if not np.isfinite(matrix).all():
-            raise ValueError(f"the env returned observations with NaN or infinite values "
-                             f"(observation space {self.space})")
-        return matrix
+    def batch(self, obs, source="the env returned a batch"):
+        """A vector env's batched observations as a new matrix, checked to be finite;
+        `source` says where they came from in errors."""
+        return self._finite(self._matrix(np.array(obs, dtype=self.dtype), source), source)
 
     def replaced(self, batch, mask, observations):
         """`batch` with the rows of `mask` replaced by `observations`, one each."""
@@ -64,12 +61,18 @@ class _FeatureRows:
         if array.dtype.kind not in "biuf":
             raise TypeError(f"observation must hold numbers, got dtype {array.dtype}")
         single = array.shape == self.space.shape
-        return self._matrix(array[None] if single else array, batch=False), single
+        matrix = self._matrix(array[None] if single else array, "the observation is")
+        return self._finite(matrix, "the observation is"), single
 
-    def _matrix(self, array, batch):
+    def _finite(self, matrix, source):
+        if not np.isfinite(matrix).all():
+            raise ValueError(f"{source} not finite (NaN or infinite values); the observation "
+                             f"space is {self.space}")
+        return matrix
+
+    def _matrix(self, array, source):
         shape = self.space.shape
         if array.ndim != len(shape) + 1 or array.shape[1:] != shape:
-            source = "the env returned a batch" if batch else "observation has"
             raise ValueError(f"{source} of shape {array.shape}; expected {shape} for one "
                              f"observation or (batch, {', '.join(map(str, shape))}) for a "
                              f"batch (observation space {self.space})")
@@ -91,20 +94,21 @@ class _ObjectRows:
         self.space = space
         self.width = _row_box(space).shape[0]     # d + 1
 
-    def _rows(self, observation):
+    def _rows(self, observation, source="the env returned a batch"):
         """One observation (stacked, or a tuple of rows) as an ``(n, d + 1)`` array."""
         rows = np.asarray(observation, dtype=np.float32)
         if rows.size and (rows.ndim != 2 or rows.shape[1] != self.width):
-            raise ValueError(f"the env returned an observation of shape {rows.shape}, but the "
-                             f"rows of its observation space {self.space} have {self.width} "
+            raise ValueError(f"{source} with an observation of shape {rows.shape}, but the "
+                             f"rows of the observation space {self.space} have {self.width} "
                              f"numbers")
         return rows.reshape(-1, self.width)
 
-    def batch(self, obs):
-        """A vector env's batched observations as an ObjectSets."""
+    def batch(self, obs, source="the env returned a batch"):
+        """A vector env's batched observations as an ObjectSets; `source` says where they
+        came from in errors."""
         if hasattr(obs, "data") and hasattr(obs, "offsets"):
             return obs if isinstance(obs, ObjectSets) else ObjectSets(obs.data, obs.offsets)
-        return ObjectSets.from_sequence([self._rows(o) for o in obs])
+        return ObjectSets.from_sequence([self._rows(o, source) for o in obs])
 
     def replaced(self, batch, mask, observations):
         """`batch` with the sets of `mask` replaced by `observations`, one each."""

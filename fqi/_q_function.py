@@ -8,6 +8,8 @@ from sklearn.base import clone
 
 from boxtrees._threads import side_by_side, threads_for
 
+from ._calls import _SMALL_BATCH, _regressor_calls
+
 __all__ = []
 
 
@@ -106,8 +108,11 @@ class _QFunction:
         n_actions)``, predicted in up to `n_jobs` threads, the calling one among them (the
         actions split between them; a box forest then predicts on its share of the cores,
         see `boxtrees._threads.threads_for`) and checked to be one finite value per
-        observation."""
-        n_threads = min(threads_for(n_jobs), len(self.models))
+        observation. A batch of fewer than `_calls._SMALL_BATCH` observations (an
+        environment step's) is predicted in the calling thread alone, starting no thread
+        (`_calls._regressor_calls`)."""
+        n_threads = (min(threads_for(n_jobs), len(self.models)) if len(batch) >= _SMALL_BATCH
+                     else 1)   # (an environment step's batch: handing it over costs more)
         edges = np.linspace(0, len(self.models), n_threads + 1).astype(int)
         predictions = [prediction for part in side_by_side(
             [partial(_predictions, self.models[a:b], batch) for a, b in zip(edges, edges[1:])],
@@ -157,8 +162,9 @@ class _ActionInputQFunction:
         """A clone of `regressor` (its ``random_state`` parameters drawn from `rng`) fitted
         on every transition, encoded; `previous` is unused (every action is in the input)."""
         model = _seeded_clone(regressor, rng)
-        return cls(model.fit(_encoded(encode, data.states, data.actions, n_actions), targets),
-                   n_actions, iteration, encode)
+        with _regressor_calls():
+            model = model.fit(_encoded(encode, data.states, data.actions, n_actions), targets)
+        return cls(model, n_actions, iteration, encode)
 
     def _every_action(self, batch):
         """Each observation of `batch` with each action in turn, encoded: ``n_actions`` rows
@@ -171,7 +177,9 @@ class _ActionInputQFunction:
         n_actions)``, in one call of the regressor's ``predict`` (its own threads: `n_jobs`
         is unused here), checked as in `_QFunction.values`."""
         n = len(batch) * self.n_actions
-        q = _checked_prediction(self.model.predict(self._every_action(batch)), n,
+        with _regressor_calls(n):
+            prediction = self.model.predict(self._every_action(batch))
+        q = _checked_prediction(prediction, n,
                                 lambda: f"iteration {self.iteration}'s Q-function "
                                         f"({self.model!r})")
         return q.reshape(len(batch), self.n_actions)
@@ -210,7 +218,8 @@ def _with_actions(states, actions, n_actions):
 def _fit_into(models, index, states, targets, mask):
     """Fit ``models[index]`` on the `states` and `targets` of `mask` (taken here: only the
     data sets being fitted exist at once) and put what its ``fit`` returns in its place."""
-    models[index] = models[index].fit(states[mask], targets[mask])
+    with _regressor_calls():
+        models[index] = models[index].fit(states[mask], targets[mask])
 
 
 def _run_all(queue):
@@ -226,7 +235,8 @@ def _run_all(queue):
 
 def _predictions(models, batch):
     """Each of `models`' ``predict(batch)``, in a list."""
-    return [model.predict(batch) for model in models]
+    with _regressor_calls(len(batch)):
+        return [model.predict(batch) for model in models]
 
 
 def _seeded_clone(regressor, rng):
@@ -355,7 +365,10 @@ class _LeafTable:
         self._n_reached = self._reached.sum(axis=1)
         self._counts = np.maximum(counts, 1)
         self._alone = np.flatnonzero(self._n_reached == 0)  # reaches no leaf with data
-        self._own = model.predict(next_states[self._alone]) if len(self._alone) else None
+        self._own = None
+        if len(self._alone):
+            with _regressor_calls(len(self._alone)):
+                self._own = model.predict(next_states[self._alone])
 
     @property
     def n_next(self):
@@ -377,7 +390,8 @@ class _LeafTable:
 
 def _leaves(model, X):
     """``model.apply(X)`` as leaf ids of shape (n, n_trees)."""
-    leaves = np.asarray(model.apply(X))
+    with _regressor_calls(len(X)):
+        leaves = np.asarray(model.apply(X))
     if leaves.ndim == 1:
         leaves = leaves[:, None]
     if leaves.ndim != 2 or leaves.shape[0] != len(X) or not np.issubdtype(leaves.dtype,
@@ -392,7 +406,9 @@ def _check_leaf_means(model, X, y):
     """Check that `model`, fitted on ``(X, y)``, predicts the mean over its trees of its
     leaves' mean target (what `_QFunction.backups` relies on); ValueError if not."""
     table = _LeafTable(model, X, X)
-    if not np.allclose(table.next_values(y), model.predict(X), rtol=1e-6, atol=1e-9):
+    with _regressor_calls(len(X)):
+        prediction = model.predict(X)
+    if not np.allclose(table.next_values(y), prediction, rtol=1e-6, atol=1e-9):
         raise ValueError(f"leaf_backups needs a regressor that predicts the mean over its "
                          f"trees of the mean training target in each leaf (a forest without "
                          f"bootstrap, such as scikit-learn's ExtraTreesRegressor or "

@@ -103,7 +103,7 @@ def test_a_minari_dataset_made_here_is_learned(tmp_path, monkeypatch):
     (lambda d: d.update(next_observations=d["next_observations"][:5]), ValueError,
      "10 observations and 5 next observations"),
     (lambda d: d.update(observations=np.zeros((10, 3))), ValueError,
-     "the dataset's observations: .*shape"),
+     "the dataset's observations are a batch of shape"),
 ])
 def test_a_bad_dataset_is_named(change, error, match):
     data = {key: np.asarray(value) for key, value in random_transitions("CartPole-v1", 10).items()}
