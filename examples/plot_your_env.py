@@ -50,12 +50,13 @@ env = gym.wrappers.TimeLimit(Walk(), max_episode_steps=30)
 # ``learn(total_timesteps=...)`` works as in stable-baselines3: rounds of
 # ``samples_per_iteration`` environment steps, each followed by ``resample_every``
 # fitted-Q backups (5 by default) on every transition kept so far. The probability of a
-# random action falls from 1 to 0.05 over the first tenth of the steps, and after every
-# backup the greedy policy plays 10 evaluation episodes from fixed reset seeds. The env is
-# copied into 16 envs played side by side (``n_envs``), so the regressors predict the
+# random action falls from 1 to 0.05 over the first tenth of the steps. As in
+# stable-baselines3, nothing is evaluated unless asked: here, after every backup, the greedy
+# policy plays 10 evaluation episodes from fixed reset seeds (``eval_episodes=10``). The env
+# is copied into 16 envs played side by side (``n_envs``), so the regressors predict the
 # actions of 16 states at a time.
 regressor = ExtraTreesRegressor(n_estimators=20, random_state=0)
-agent = FQI(regressor, env, samples_per_iteration=1_000, n_envs=16, seed=0)
+agent = FQI(regressor, env, samples_per_iteration=1_000, n_envs=16, eval_episodes=10, seed=0)
 agent.learn(total_timesteps=5_000)
 
 # Each record of ``agent.history`` is one iteration. The first round's random data
