@@ -11,7 +11,7 @@ SOURCES := setup.py pyproject.toml constraints.txt $(wildcard boxtrees/*.pyx box
 # the CUDA one, unless pip is configured with a CPU file).
 TORCH_INDEX := https://download.pytorch.org/whl/cpu
 
-.PHONY: bench test install clean
+.PHONY: bench test test-slow install clean
 
 bench: $(VENV)/.installed
 	$(PY) -m benchmarks.run_all --quick --jobs 2
@@ -19,7 +19,12 @@ bench: $(VENV)/.installed
 # a test file per worker, handed out in collection order: the few long files (the games,
 # the sanitizer build) start early instead of after xdist's largest-first order
 test: $(VENV)/.installed
-	$(PY) -m pytest -q -n auto --dist loadfile --no-loadscope-reorder tests
+	$(PY) -m pytest -q -n auto --dist loadfile --no-loadscope-reorder -m "not slow" tests
+
+# the tests marked slow (minutes each: the sanitizers, a Dask cluster, an Atari game end to
+# end); CI runs them after `make test`
+test-slow: $(VENV)/.installed
+	$(PY) -m pytest -q -n auto --dist loadfile --no-loadscope-reorder -m slow tests
 
 install: $(VENV)/.installed
 

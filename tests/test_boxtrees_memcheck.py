@@ -12,6 +12,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow   # the kernels under valgrind: about 40 s
+
 SCRIPT = Path(__file__).with_name("kernel_driver.py")
 # a valgrind error report: its kind, then the call stack, up to the next blank report line
 ERROR = re.compile(r"==\d+== (Invalid (?:read|write)[^\n]*|[^\n]*uninitialised[^\n]*)\n((?:==\d+== {3,}[^\n]*\n)+)")

@@ -16,6 +16,8 @@ from benchmarks.reproduce.runner import MAX_ATTEMPTS, ClusterError, cluster, pla
 
 from harness import FQI_RESULT, TINY, interrupt
 
+pytestmark = pytest.mark.slow   # a local cluster of worker processes: about 90 s
+
 
 # ------------------------------------------------------------------------------ Dask cluster
 def _timeless(value):

@@ -19,6 +19,7 @@ pytestmark = pytest.mark.skipif(importlib.util.find_spec("ocatari") is None,
                                 reason="needs the atari extra (ocatari)")
 
 
+@pytest.mark.slow   # five learners on Freeway's emulator: two to three minutes
 def test_an_atari_game_runs_every_learner_and_reference_end_to_end(tmp_path):
     report = main(["--budget", "tiny", "--only", "games_freeway", "--out", str(tmp_path),
                    "--no-progress"]).read_text()
