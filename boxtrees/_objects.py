@@ -777,9 +777,34 @@ class ObjectInputMixin:
             data[:, -1] = table[data[:, -1].astype(np.intp)]
         return ObjectSets._trusted(data, sets.offsets, fitted)
 
+    def _one_set(self, X):
+        """The fast path of `_validate_input` at predict time, for the input of a single
+        observation: ``X`` a list or tuple of one non-empty 2D NumPy array whose rows have the
+        fitted width, given to an estimator fitted on object sets without type names. Returns
+        the validated ObjectSets, or None for any other ``X`` (which takes the general path).
+
+        The general path would run the same checks on such an ``X``, in this order: it is not
+        empty, it is read as object sets (a 2D item), the estimator was fitted on sets, then
+        `_check_rows` of the array (whose errors are raised here as they are there), the
+        width, and no type names on either side (no warning, no renaming)."""
+        if type(X) is not list and type(X) is not tuple or len(X) != 1:
+            return None
+        data = X[0]
+        if (type(data) is not np.ndarray or data.ndim != 2 or not data.shape[0]
+                or data.shape[1] != self.__dict__.get("n_attributes_", -2) + 1
+                or self.__dict__.get("_fitted_on_features", True)
+                or self.__dict__.get("type_names_") is not None):
+            return None
+        data = _check_rows(data)
+        return ObjectSets._trusted(data, np.array((0, len(data)), dtype=np.intp))
+
     def _validate_input(self, X, y=None, *, reset, requires_y=False, matrix=False):
         """Validate ``X`` (and ``y``) and return ``(sets, y)``; with ``matrix``, a feature
         matrix is returned as the validated float32 matrix instead of as object sets."""
+        if not reset and not requires_y:
+            sets = self._one_set(X)
+            if sets is not None:
+                return sets, None
         from sklearn.utils.validation import check_array, validate_data
 
         if requires_y and issparse(y):

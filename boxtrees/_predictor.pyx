@@ -14,12 +14,17 @@ report the first bad row instead of reading past an array. Samples are processed
 tree by tree, so that a tree's nodes stay in cache across a block. The walk itself is a kernel
 of ``_simd.h``: with AVX-512 it walks two samples side by side, tests up to 16 of a
 sample's objects at once, and tests a chain of up to 16 nodes that mostly send samples left
-(`_chains`) at once.
+(`_chains`) at once. Without AVX-512, a batch whose objects take little
+more room padded by type (every type's objects of a sample in as many slots, a multiple of 4,
+NaN in the spare ones) is walked with a node count of a fixed length per sample
+(`boxtrees_count_padded`), which the branch predictor never misses: about 2x faster than the
+portable kernel of ``_simd.h``, with the same leaves.
 """
 import numpy as np
 
 cimport numpy as cnp
 from libc.math cimport INFINITY
+from libc.stdlib cimport calloc, free, malloc
 from libc.stdint cimport INT32_MAX
 
 from ._layout import EXTRA_DTYPE, MAX_ATTRIBUTES, NODE_DTYPE
@@ -33,6 +38,76 @@ from ._utils cimport (
 )
 
 cnp.import_array()
+
+cdef extern from *:
+    """
+    #include <math.h>
+    #include "_simd.h"
+    #ifdef __SSE2__
+    #include <emmintrin.h>
+    #endif
+        /* A sample's objects padded by type: attribute c of its objects of type position t is
+       objects[(t * n_attributes + c) * m + k], k < m, m a multiple of 4 (at least as many as
+       the sample has objects of any type), NaN after the last. A node's count is then a loop
+       of a fixed length per sample, which never mispredicts, and NaN is inside no box. */
+    static inline int32_t boxtrees_count_padded(const boxtrees_node *n,
+                                                const boxtrees_extra *extras,
+                                                const float *objects, int64_t n_attributes,
+                                                int64_t m)
+    {
+        const float *base = objects + n->object_type * n_attributes * m;
+        const float *x = base + n->x_column * m, *y = base + n->y_column * m;
+        int32_t count = 0;
+        if (n->extra >= 0) {
+            for (int64_t k = 0; k < m; k++) {
+                int inside = (x[k] > n->box[0]) & (x[k] < n->box[1]) & (y[k] > n->box[2])
+                             & (y[k] < n->box[3]);
+                for (const boxtrees_extra *e = extras + n->extra; e->column >= 0; e++) {
+                    float v = base[e->column * m + k];
+                    inside &= (v > e->low) & (v < e->high);
+                }
+                count += inside;
+            }
+            return count;
+        }
+    #ifdef __SSE2__
+        __m128 x0 = _mm_set1_ps(n->box[0]), x1 = _mm_set1_ps(n->box[1]);
+        __m128 y0 = _mm_set1_ps(n->box[2]), y1 = _mm_set1_ps(n->box[3]);
+        __m128i total = _mm_setzero_si128();
+        for (int64_t k = 0; k < m; k += 4) {
+            __m128 xs = _mm_loadu_ps(x + k), ys = _mm_loadu_ps(y + k);
+            __m128 in = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(xs, x0), _mm_cmplt_ps(xs, x1)),
+                                   _mm_and_ps(_mm_cmpgt_ps(ys, y0), _mm_cmplt_ps(ys, y1)));
+            total = _mm_sub_epi32(total, _mm_castps_si128(in));   /* -1 per lane inside */
+        }
+        total = _mm_add_epi32(total, _mm_shuffle_epi32(total, 0x4E));
+        total = _mm_add_epi32(total, _mm_shuffle_epi32(total, 0xB1));
+        count = _mm_cvtsi128_si32(total);
+    #else
+        for (int64_t k = 0; k < m; k++)
+            count += (x[k] > n->box[0]) & (x[k] < n->box[1]) & (y[k] > n->box[2]) & (y[k] < n->box[3]);
+    #endif
+        return count;
+    }
+
+    /* The tree-local leaf that a sample (its padded objects) reaches from root `nodes`: the
+       node test of boxtrees_find_leaf_portable. */
+    static inline int64_t boxtrees_walk_padded(const boxtrees_node *nodes,
+                                               const boxtrees_extra *extras,
+                                               const float *objects, int64_t n_attributes,
+                                               int64_t m)
+    {
+        const boxtrees_node *n = nodes;
+        while (n->left != -1) {
+            int32_t count = boxtrees_count_padded(n, extras, objects, n_attributes, m);
+            n = nodes + (count < n->threshold ? n->left : n->right);
+        }
+        return n - nodes;
+    }
+    """
+    intp_t boxtrees_walk_padded(const boxtrees_node* nodes, const boxtrees_extra* extras,
+                                const coord_t* objects, intp_t n_attributes,
+                                intp_t m) noexcept nogil
 
 cdef enum:
     BLOCK = 64
@@ -282,68 +357,145 @@ cdef class PackedForest:
 
         Returns ``(problem, row)``: ``problem`` is ``ROW_OK``, or what is wrong with data
         row ``row`` (or ``BAD_OFFSETS`` at offset position ``row``); nothing is walked then.
+        Its scratch arrays come from malloc, not NumPy: a single sample's call is mostly
+        their cost otherwise.
         """
-        cdef intp_t[::1] offs = np.array(offsets, dtype=np.intp)    # read once, here
-        cdef intp_t n_sets = offs.shape[0] - 1, n_rows = data.shape[0], stride = self.n_types + 1
+        cdef intp_t n_sets = max(offsets.shape[0] - 1, 0), n_rows = data.shape[0]
+        cdef intp_t stride = self.n_types + 1
         cdef intp_t i, k, d, c, pos = 0, row = -1, n_attributes = self.n_attributes
         cdef int problem = ROW_OK
+        cdef intp_t* offs = NULL         # the offsets, read once, here
+        cdef intp_t* type_ptr = NULL     # (n_sets, stride): each sample's type starts
+        cdef intp_t* cursor = NULL
+        cdef coord_t* features = NULL
+        cdef int32* positions = NULL
+        cdef intp_t padded, most
         if data.shape[1] != n_attributes + 1:
             raise ValueError(f"object rows must have {n_attributes + 1} columns (the forest's "
                              f"{n_attributes} attributes and the type), got {data.shape[1]}")
-        for i in range(n_sets + 1):
-            if offs[i] < 0 or offs[i] > n_rows or (i > 0 and offs[i] < offs[i - 1]):
-                return BAD_OFFSETS, i
-        type_ptr_arr = np.zeros((max(n_sets, 0), stride), dtype=np.intp)
-        cdef intp_t[:, ::1] type_ptr = type_ptr_arr
-        cdef intp_t[::1] cursor = np.empty(stride, dtype=np.intp)
-        with nogil:
-            for i in range(n_sets):
-                for k in range(offs[i], offs[i + 1]):
-                    problem = row_problem(&data[k, 0], n_attributes, INFINITY, MAX_TYPE)
-                    if problem == ROW_TYPE_TOO_LARGE:
-                        problem = ROW_OK       # an id no tree tests
-                        continue
+        try:
+            offs = <intp_t*>malloc((n_sets + 1 + stride) * sizeof(intp_t))
+            type_ptr = <intp_t*>calloc(n_sets * stride + 1, sizeof(intp_t))
+            if offs == NULL or type_ptr == NULL:
+                raise MemoryError()
+            cursor = offs + n_sets + 1
+            for i in range(offsets.shape[0]):
+                offs[i] = offsets[i]
+            for i in range(offsets.shape[0]):
+                if offs[i] < 0 or offs[i] > n_rows or (i > 0 and offs[i] < offs[i - 1]):
+                    return BAD_OFFSETS, i
+            with nogil:
+                for i in range(n_sets):
+                    for k in range(offs[i], offs[i + 1]):
+                        problem = row_problem(&data[k, 0], n_attributes, INFINITY, MAX_TYPE)
+                        if problem == ROW_TYPE_TOO_LARGE:
+                            problem = ROW_OK       # an id no tree tests
+                            continue
+                        if problem != ROW_OK:
+                            row = k
+                            break
+                        d = self._position(<intp_t>data[k, n_attributes])
+                        if d >= 0:
+                            type_ptr[i * stride + d + 1] += 1
                     if problem != ROW_OK:
-                        row = k
                         break
-                    d = self._position(<intp_t>data[k, n_attributes])
-                    if d >= 0:
-                        type_ptr[i, d + 1] += 1
-                if problem != ROW_OK:
-                    break
-                type_ptr[i, 0] = pos
-                for d in range(self.n_types):
-                    pos += type_ptr[i, d + 1]
-                    type_ptr[i, d + 1] = pos
-        if problem != ROW_OK:
-            return problem, row
-        features_arr = np.zeros((n_attributes, pos), dtype=np.float32)
-        cdef coord_t[:, ::1] features = features_arr
-        # each object's type position, which only the walk of a chain reads
-        positions_arr = np.empty(pos if self.n_chains else 0, dtype=np.int32)
-        cdef int32[::1] positions = positions_arr
-        with nogil:
-            for i in range(n_sets if self.n_chains else 0):
-                for d in range(self.n_types):
-                    for k in range(type_ptr[i, d], type_ptr[i, d + 1]):
-                        positions[k] = <int32>d
-            # the rows are read again: every index is re-checked where it is used, so rows
-            # changed in between cannot move a write out of its sample's range
-            for i in range(n_sets):
-                for d in range(self.n_types):
-                    cursor[d] = type_ptr[i, d]
-                for k in range(offs[i], offs[i + 1]):
-                    if not (0 <= data[k, n_attributes] < MAX_TYPE):
-                        continue
-                    d = self._position(<intp_t>data[k, n_attributes])
-                    if d >= 0 and cursor[d] < type_ptr[i, d + 1]:
-                        for c in range(n_attributes):
-                            features[c, cursor[d]] = data[k, c]
-                        cursor[d] += 1
-            _walk(&self._view, &features[0, 0] if pos else &_NO_OBJECT, pos,
-                  &positions[0] if positions.shape[0] else NULL,
-                  &type_ptr[0, 0] if n_sets > 0 else NULL,
-                  stride, n_sets, mean, leaves)
+                    type_ptr[i * stride] = pos
+                    for d in range(self.n_types):
+                        pos += type_ptr[i * stride + d + 1]
+                        type_ptr[i * stride + d + 1] = pos
+            if problem != ROW_OK:
+                return problem, row
+            if _kernels.lanes != 16:
+                # the portable walk reads each sample's objects padded by type (see
+                # boxtrees_count_padded), unless padding would take much more room
+                padded = 0
+                for i in range(n_sets):
+                    most = 0
+                    for d in range(self.n_types):
+                        most = max(most, type_ptr[i * stride + d + 1] - type_ptr[i * stride + d])
+                    padded += self.n_types * ((most + 3) & ~3)
+                if padded <= 4 * pos + 16 * n_sets:
+                    return self._run_padded(data, offs, type_ptr, n_sets, padded, mean, leaves)
+            features = <coord_t*>calloc(n_attributes * pos + 1, sizeof(coord_t))
+            # each object's type position, which only the AVX-512 walk of a chain reads
+            positions = <int32*>malloc((pos if self.n_chains else 0) * sizeof(int32) + 1)
+            if features == NULL or positions == NULL:
+                raise MemoryError()
+            with nogil:
+                for i in range(n_sets if self.n_chains else 0):
+                    for d in range(self.n_types):
+                        for k in range(type_ptr[i * stride + d], type_ptr[i * stride + d + 1]):
+                            positions[k] = <int32>d
+                # the rows are read again: every index is re-checked where it is used, so
+                # rows changed in between cannot move a write out of its sample's range
+                for i in range(n_sets):
+                    for d in range(self.n_types):
+                        cursor[d] = type_ptr[i * stride + d]
+                    for k in range(offs[i], offs[i + 1]):
+                        if not (0 <= data[k, n_attributes] < MAX_TYPE):
+                            continue
+                        d = self._position(<intp_t>data[k, n_attributes])
+                        if d >= 0 and cursor[d] < type_ptr[i * stride + d + 1]:
+                            for c in range(n_attributes):
+                                features[c * pos + cursor[d]] = data[k, c]
+                            cursor[d] += 1
+                _walk(&self._view, features, pos, positions, type_ptr, stride, n_sets, mean,
+                      leaves)
+        finally:
+            free(offs)
+            free(type_ptr)
+            free(features)
+            free(positions)
+        return ROW_OK, -1
+
+
+    cdef tuple _run_padded(self, const coord_t[:, ::1] data, const intp_t* offs,
+                           const intp_t* type_ptr, intp_t n_sets, intp_t padded,
+                           float64_t* mean, intp_t* leaves):
+        """`_run`'s walk with the portable node test: each sample's objects padded by type
+        (``padded`` slots in all, `boxtrees_count_padded`), walked down every tree
+        (`_walk_padded`). ``type_ptr`` are the samples' type offsets `_run` counted."""
+        cdef intp_t stride = self.n_types + 1, n_types = self.n_types
+        cdef intp_t n_attributes = self.n_attributes
+        cdef intp_t i, k, d, c, m, most, base, at
+        cdef coord_t nan = float("nan")
+        cdef intp_t* layout = <intp_t*>malloc((2 * n_sets + 1) * sizeof(intp_t))
+        cdef intp_t* cursor = <intp_t*>malloc((n_types + 1) * sizeof(intp_t))
+        cdef coord_t* objects = <coord_t*>malloc((padded * n_attributes + 1) * sizeof(coord_t))
+        try:
+            if layout == NULL or cursor == NULL or objects == NULL:
+                raise MemoryError()
+            with nogil:
+                base = 0
+                for i in range(n_sets):         # each sample's first slot and its m
+                    most = 0
+                    for d in range(n_types):
+                        most = max(most, type_ptr[i * stride + d + 1] - type_ptr[i * stride + d])
+                    m = (most + 3) & ~3
+                    layout[2 * i], layout[2 * i + 1] = base, m
+                    base += n_types * n_attributes * m
+                for k in range(padded * n_attributes):
+                    objects[k] = nan
+                # the rows are read again: every index is re-checked where it is used, so
+                # rows changed in between cannot move a write out of its sample's slots
+                for i in range(n_sets):
+                    base, m = layout[2 * i], layout[2 * i + 1]
+                    for d in range(n_types):
+                        cursor[d] = 0
+                    for k in range(offs[i], offs[i + 1]):
+                        if not (0 <= data[k, n_attributes] < MAX_TYPE):
+                            continue
+                        d = self._position(<intp_t>data[k, n_attributes])
+                        if d >= 0 and cursor[d] < type_ptr[i * stride + d + 1] - type_ptr[i * stride + d]:
+                            at = base + d * n_attributes * m + cursor[d]
+                            for c in range(n_attributes):
+                                objects[at + c * m] = data[k, c]
+                            cursor[d] += 1
+                _walk_padded(&self._view, objects, n_attributes, layout, n_sets, mean, leaves)
+        finally:
+            free(layout)
+            free(cursor)
+            free(objects)
         return ROW_OK, -1
 
 
@@ -414,6 +566,39 @@ cdef intp_t _chains(boxtrees_node* nodes, const intp_t[::1] offsets,
                 c.max_objects = <int32>(OBJECTS_PER_LANE * lanes_passed)
                 c.n += 1
     return n_kept
+
+
+cdef void _walk_padded(const ForestView* forest, const coord_t* objects, intp_t n_attributes,
+                       const intp_t* layout, intp_t n_samples, float64_t* mean,
+                       intp_t* leaves) noexcept nogil:
+    """`_walk` with the portable node test on padded objects (`boxtrees_count_padded`: sample
+    ``i``'s start at ``objects + layout[2 * i]``, ``m = layout[2 * i + 1]``), in blocks, tree
+    by tree, as `_walk`: the same leaves, and the same means."""
+    cdef const boxtrees_node* nodes = forest.nodes
+    cdef const intp_t* tree_offsets = forest.tree_offsets
+    cdef const float64_t* value = forest.value
+    cdef intp_t n_trees = forest.n_trees, n_outputs = forest.n_outputs
+    cdef intp_t block = 0, block_end, tree, i, k, leaf
+    while block < n_samples:
+        block_end = min(block + <intp_t>BLOCK, n_samples)
+        if mean != NULL:
+            for i in range(block * n_outputs, block_end * n_outputs):
+                mean[i] = 0.0
+        for tree in range(n_trees):
+            for i in range(block, block_end):
+                leaf = boxtrees_walk_padded(nodes + tree_offsets[tree], forest.extras,
+                                            objects + layout[2 * i], n_attributes,
+                                            layout[2 * i + 1])
+                if mean == NULL:
+                    leaves[i * n_trees + tree] = leaf
+                    continue
+                leaf = (tree_offsets[tree] + leaf) * n_outputs
+                for k in range(n_outputs):
+                    mean[i * n_outputs + k] += value[leaf + k]
+        if mean != NULL:
+            for i in range(block * n_outputs, block_end * n_outputs):
+                mean[i] /= n_trees
+        block = block_end
 
 
 cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_objects,
