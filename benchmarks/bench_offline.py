@@ -15,7 +15,9 @@ On each, every method learns from the data alone, once per seed:
 
 - ``fqi-nmin10``, ``fqi-grown``: `fqi.FQI.learn_offline` with scikit-learn's
   ``ExtraTreesRegressor`` (30 trees, ``min_samples_split`` 10, or 2: grown out; one job),
-  discount 0.99, ``--iterations`` fitted-Q backups;
+  discount 0.99, ``--iterations`` fitted-Q backups, constrained to the actions the data
+  support with ``--support-threshold`` (FQI's default, 0.3; ``none``: unconstrained, the
+  runs made before FQI had the constraint);
 - ``d3rlpy-dqn``, ``d3rlpy-cql``: d3rlpy's ``DQN`` and ``DiscreteCQL`` (d3rlpy's own
   discrete algorithms and default network, two hidden layers of 256) with the settings of
   d3rlpy's CartPole examples (learning rate 1e-3, target network copied every 100 updates),
@@ -261,21 +263,35 @@ def held_out_return(policy):
         env.close()
 
 
-def make_agent(method, seed):
-    """The untrained FQI agent of `method` (one of `FQI_METHODS`), as every run uses it."""
+def make_agent(method, seed, support_threshold=None):
+    """The untrained FQI agent of `method` (one of `FQI_METHODS`), as every run uses it,
+    with FQI's offline constraint `support_threshold` (None: unconstrained)."""
     from fqi import FQI
 
     return FQI(make_regressor(FQI_METHODS[method]), ENV_ID, gamma=GAMMA, n_envs=1,
-               eval_episodes=0, seed=seed)
+               eval_episodes=0, seed=seed, support_threshold=support_threshold)
 
 
-def run_fqi(data, method, seed, n_iterations):
+def run_fqi(data, method, seed, n_iterations, support_threshold=None):
     """`FQI.learn_offline` on `data`; the record of the run (no file written)."""
-    agent = make_agent(method, seed)
+    agent = make_agent(method, seed, support_threshold)
     _, seconds, cpu_seconds = timed(agent.learn_offline, data, n_iterations=n_iterations)
     return {"budget": {"iterations": n_iterations}, "train_seconds": seconds,
             "train_cpu_seconds": cpu_seconds, "mean_return": held_out_return(agent),
-            "settings": repr(agent.regressor)}
+            "settings": repr(agent.regressor), "support_threshold": support_threshold}
+
+
+def fqi_budget(args):
+    """The budget part of an FQI run's key: the iterations, and the support threshold
+    unless unconstrained (so runs of either kind are kept apart)."""
+    if args.support_threshold is None:
+        return args.iterations
+    return f"{args.iterations}-support{args.support_threshold:g}"
+
+
+def threshold(text):
+    """``--support-threshold``: a number, or ``none``."""
+    return None if text.lower() == "none" else float(text)
 
 
 def _require_d3rlpy():
@@ -430,8 +446,9 @@ def read_info(data_dir):
 
 
 def fqi_part(args):
-    run_part(args, list(FQI_METHODS), args.iterations,
-             lambda data, method, seed, key: run_fqi(data, method, seed, args.iterations))
+    run_part(args, list(FQI_METHODS), fqi_budget(args),
+             lambda data, method, seed, key: run_fqi(data, method, seed, args.iterations,
+                                                     args.support_threshold))
 
 
 def d3rlpy_part(args):
@@ -471,7 +488,7 @@ def load_runs(args, info):
     runs = []
     for name in DATASETS:
         for method in METHODS:
-            budget = args.iterations if method in FQI_METHODS else args.gradient_steps
+            budget = fqi_budget(args) if method in FQI_METHODS else args.gradient_steps
             for seed in args.seeds:
                 key = run_key(name, method, seed, budget, args.transitions)
                 path = args.out / "runs" / f"{key}.json"
@@ -611,6 +628,8 @@ def parse_args(argv=None):
     parser.add_argument("--transitions", type=int, default=50_000,
                         help="transitions in each data set")
     parser.add_argument("--iterations", type=int, default=50, help="FQI's backups")
+    parser.add_argument("--support-threshold", type=threshold, default=0.3,
+                        help="FQI's offline constraint (support_threshold), or none")
     parser.add_argument("--gradient-steps", type=int, default=10_000,
                         help="d3rlpy's updates")
     parser.add_argument("--quick", action="store_true",

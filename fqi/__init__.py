@@ -4,7 +4,9 @@ plus the baselines of the thesis.
 - `FQI`: the agent (``learn``, ``predict``, ``save`` / ``load``, a CSV log), on ``Box``
   observations (a feature matrix: any scikit-learn regressor) or object sets
   (``Sequence(Box(shape=(d + 1,)))``, rows ``[f_1, ..., f_d, type]``:
-  `boxtrees.BoxExtraTreesRegressor`);
+  `boxtrees.BoxExtraTreesRegressor`); ``learn_offline`` learns from a fixed data set (a
+  mapping of arrays, Minari's or d3rlpy's), its backups and greedy actions kept to the
+  actions the data support (``support_threshold``);
 - `evaluate`: one greedy episode per fixed reset seed, total and mean return, for any policy
   with a ``predict`` method (`RandomPolicy`, DQN, `FQI`);
 - baselines: `make_box_forest` (thesis parameters; ``test_type="classic"``),

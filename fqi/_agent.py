@@ -15,6 +15,7 @@ from sklearn.base import clone, is_classifier
 from sklearn.exceptions import NotFittedError
 from tqdm.auto import tqdm
 
+from ._behaviour import _default_classifier, _Support
 from ._callbacks import _as_callback
 from ._calls import _regressor_calls
 from ._checks import (_check_bool, _check_choice, _check_int, _check_n_jobs, _check_real,
@@ -28,7 +29,7 @@ from ._evaluate import _eval_seeds, evaluate
 from ._logger import CSVLogger, _KeyValueLogger
 from ._observations import _ObjectRows, _observation_format
 from ._q_function import (_ActionInputQFunction, _check_leaf_means, _checked_prediction,
-                          _DoubleQFunction, _encoded, _QFunction)
+                          _DoubleQFunction, _encoded, _masked, _QFunction)
 from ._saving import _read_save, _write_save
 from ._typing import Callback, Dataset, EnvLike, Logger, Observation, Regressor
 
@@ -40,8 +41,8 @@ _TIE_TOLERANCE = 1e-6  # relative: Q-values closer than this to the best tie wit
 _MAX_HOLD = 10_000  # steps: the cap on the duration of a held exploratory action
 # What `save` leaves out (SB3 saves its __dict__ minus such a list): the envs, which hold
 # simulators, the transitions, the threads and the logs.
-_UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_held", "_data", "_csv_log",
-                      "_logger"})
+_UNSAVED = frozenset({"_env", "_eval_env", "_collector", "_held", "_data", "_next_supported",
+                      "_csv_log", "_logger"})
 # What a save holds beyond the constructor parameters.
 _LEARNED = ("_q", "history", "num_timesteps", "iteration", "observation_space",
             "action_space")
@@ -179,6 +180,29 @@ class FQI:
         splits, so their Q-values err together where separate regressors err apart (the
         likely reason it plays better on Acrobot-v1, not measured apart: ``docs/fqi.md``).
         Not with `double`. A callable must pickle (a module-level function) for `save`.
+    support_threshold : float or None, default=0.3
+        The offline constraint: backups and greedy actions limited to the actions the data
+        support ("never below the data"). `learn_offline` fits a behaviour model, a
+        classifier of the data set's actions given its states (`support_classifier`),
+        which gives each action's share at a state; an action is supported there when its
+        share is at least `support_threshold` times the largest (BCQ's relative threshold,
+        "Benchmarking Batch Deep Reinforcement Learning Algorithms", 2019). The backups'
+        ``max_a Q(s', a)`` and the greedy action (`predict`, and the greedy action of a
+        later `learn`'s collection) then range over the supported actions only: fitted
+        Q-iteration no longer bootstraps on values its regressor extrapolates to actions
+        the data never take at a state. 0 or None: every action (FQI as it was; None fits
+        no behaviour model, and ``FQI.load(path, support_threshold=None)`` lifts a saved
+        agent's constraint). In ``[0, 1]``; 1 keeps the data's most frequent action alone.
+        A `learn` after `learn_offline` refits the behaviour model on the grown data set
+        after each collection round; an agent that never learned offline is unconstrained.
+    support_classifier : scikit-learn classifier, default=None
+        Template of the behaviour model (with ``fit`` and ``predict_proba``, fitted on the
+        states and the actions, with its ``random_state`` parameters set from `seed`).
+        None: 30 Extra-Trees, scikit-learn's ``ExtraTreesClassifier(min_samples_leaf=5)``
+        for ``Box`` observations, ``boxtrees.BoxExtraTreesClassifier(min_samples_split=100)``
+        drawing its tests in the view for object sets (smoothed so: a data set's next
+        state is most often one of its states, and a classifier that isolates it gives
+        its own action alone).
     n_envs : int, default=None
         Envs played side by side while collecting; None: the vector env's own number, or
         16 for any other env form.
@@ -247,6 +271,9 @@ class FQI:
         Of one env.
     n_actions : int
         Number of actions (``action_space.n``): one Q-function each.
+    support_model_ : classifier or None
+        The behaviour model that `learn_offline` fitted (`support_threshold`), None
+        without one.
     logger : object
         The key-value logger of stable-baselines3 callbacks; see `FQI.logger`.
 
@@ -283,22 +310,31 @@ class FQI:
                  exploration_zeta: float | None = None, tie_break: str = "random",
                  leaf_backups: int = 0, double: bool = False,
                  action_input: bool | Callable[[Any, np.ndarray], Any] = False,
+                 support_threshold: float | None = 0.3,
+                 support_classifier: Any = None,
                  n_envs: int | None = None,
                  eval_episodes: int | None = None, eval_seeds: Sequence[int] | None = None,
                  eval_env: EnvLike | None = None, n_jobs: int = 1,
                  log_path: str | os.PathLike[str] | None = None, seed: int | None = None,
                  verbose: int | bool = 0) -> None:
         self._set_params({name: value for name, value in locals().items() if name != "self"})
-        world_seq, action_seq, fit_seq = np.random.SeedSequence(self.seed).spawn(3)
+        # (the behaviour model's stream apart: with the constraint on, the Q-functions draw
+        # the seeds they draw without it)
+        world_seq, action_seq, fit_seq, support_seq = np.random.SeedSequence(
+            self.seed).spawn(4)
         self._world_rng = np.random.default_rng(world_seq)
         self._action_rng = np.random.default_rng(action_seq)
         self._fit_rng = np.random.default_rng(fit_seq)
+        self._support_rng = np.random.default_rng(support_seq)
         # None until set_env (below) sets them: afterwards always the env's spaces
         self.observation_space = self.action_space = None  # type: ignore[assignment]
         self.exploration_rate = self.exploration_initial_eps
         # the last iteration's _QFunction (_DoubleQFunction if double, _ActionInputQFunction
         # if action_input)
         self._q = None
+        # the behaviour model of the offline data (a _Support; support_threshold), and the
+        # actions it supports at the data set's next states
+        self._support = self._next_supported = None
         self.history = []
         self.num_timesteps = 0
         self.iteration = 0
@@ -356,6 +392,18 @@ class FQI:
         if self.double and self.action_input:
             raise ValueError("double and action_input cannot be combined: Double FQI fits "
                              "a regressor per action on each half of the data")
+        threshold = params["support_threshold"]
+        self.support_threshold = (None if threshold is None
+                                  else _check_real("support_threshold", threshold, 0.0, 1.0))
+        classifier = params["support_classifier"]
+        if classifier is not None:
+            for method in ("fit", "predict_proba"):
+                if not callable(getattr(classifier, method, None)):
+                    raise TypeError(f"support_classifier must be a classifier with fit and "
+                                    f"predict_proba methods; {type(classifier).__name__} has "
+                                    f"no {method}")
+            clone(classifier)
+        self.support_classifier = classifier
         self.samples_per_iteration = _check_int("samples_per_iteration",
                                                 params["samples_per_iteration"], 1)
         resample_every = params["resample_every"]
@@ -430,7 +478,7 @@ class FQI:
         self.observation_space, self.action_space = observation_space, action_space
         self.n_actions, self._observations = n_actions, observations
         self._collector = self._held = None
-        self._data = None
+        self._data = self._next_supported = None
 
     def _check_action_input(self, observations, observation_space):
         """ValueError if `action_input` is asked of observations that are not feature
@@ -582,19 +630,30 @@ class FQI:
         """Fitted Q-iteration on a fixed data set, without playing the env: FQI as first
         formulated, and as offline reinforcement learning works.
 
-        The data set replaces the agent's transitions; `n_iterations` backups follow, each
+        The data set replaces the agent's transitions; unless `support_threshold` is None,
+        the behaviour model is fitted on it (once per call), and the backups and the greedy
+        policy keep to the actions it supports. `n_iterations` backups follow, each
         logged and evaluated as in `learn` (``eval_episodes=0`` plays nothing). A later
         `learn` goes on online: with `keep_data`, its transitions join the data set.
 
         Parameters
         ----------
-        dataset : mapping or minari.MinariDataset
+        dataset : mapping, minari.MinariDataset, d3rlpy.dataset.MDPDataset or object
             A mapping of one entry per transition: ``observations`` and
             ``next_observations`` (an array of the observation space's shape per row, or
             for object sets a list of ``(n_i, d + 1)`` arrays or a `boxtrees.ObjectSets`),
-            ``actions`` (ints), ``rewards``, ``terminations`` (bools; no bootstrap after
-            one) and optionally ``truncations`` (bootstrapped through, as online). Or a
-            Minari dataset (its episodes; its spaces must be the agent's).
+            ``actions`` (ints), ``rewards``, ``terminations`` (no bootstrap after one;
+            D4RL's name ``terminals`` too) and optionally ``truncations`` (bootstrapped
+            through, as online; or ``timeouts``); flags are bools or numbers 0 and 1. Or a
+            Minari dataset (its episodes; its spaces must be the agent's). Or d3rlpy's
+            data: a d3rlpy 2 ``MDPDataset`` (its ``episodes``, each one row per step, with
+            ``observations``, ``actions``, ``rewards`` and ``terminated``), or any object
+            with d3rlpy's arrays as attributes, ``observations``, ``actions``, ``rewards``,
+            ``terminals`` and optionally ``timeouts``: one row per step, each episode's
+            rows in order and ended by a row flagged terminal (a transition with no
+            bootstrap) or timeout (only the previous row's next observation), the next
+            observation of a row the next row's. A missing or misaligned field is a
+            ValueError naming it.
         n_iterations : int
         callback, progress_bar
             As in `learn`.
@@ -625,6 +684,9 @@ class FQI:
                              "eval_episodes=0")
         self._data = _dataset_transitions(dataset, self._observations, self.observation_space,
                                           self.action_space)
+        self._support = self._next_supported = None
+        if self.support_threshold is not None:
+            self._fit_support()
         return self._train(callback, progress_bar, None, n_iterations, collect=False)
 
     def _train(self, callback, progress_bar, total_timesteps, n_iterations, collect=True):
@@ -712,7 +774,7 @@ class FQI:
             return 0, np.nan
         try:
             batch, n_steps = self._collector.collect(
-                n_samples, self._behaviour, None if self._q is None else self._q_values)
+                n_samples, self._behaviour, None if self._q is None else self._acting_values)
         except Exception as exc:
             exc.add_note(f"(while FQI collected the transitions of iteration "
                          f"{self.iteration} on {self._env})")
@@ -723,22 +785,38 @@ class FQI:
             batch = _Transitions.concatenate([self._data, batch], self._observations.concatenate)
             batch = batch[-self.max_samples:]
         self._data = batch
+        if self._support is not None and self.support_threshold is not None:
+            self._fit_support()  # after learn_offline: the grown data set's support
         return new
+
+    def _fit_support(self):
+        """Fit the behaviour model on the data set, and find the actions it supports at
+        the data's next states (see `support_threshold`)."""
+        classifier = self.support_classifier
+        if classifier is None:
+            classifier = _default_classifier(self.observation_space)
+        self._support = _Support.fit(classifier, self._data, self.n_actions,
+                                     self._support_rng)
+        self._next_supported = self._supported(self._data.next_states)
 
     def _targets(self, data, split):
         """``r`` before any fit, then ``r + gamma * max_a Q_{n-1}(s', a)`` (no bootstrap
-        after a termination; Double FQI's crossed value, halves `split`), then
-        `leaf_backups` backups on ``Q_{n-1}``'s trees."""
+        after a termination; Double FQI's crossed value, halves `split`; the maximum over
+        the actions supported at ``s'`` under `support_threshold`), then `leaf_backups`
+        backups on ``Q_{n-1}``'s trees."""
         targets = data.rewards.copy()
         if self._q is not None:
-            # known when the data was just collected with Q_{n-1}; not Double FQI's values
-            future = None if self.double else data.next_values
+            supported = self._next_supported
+            # known when the data was just collected with Q_{n-1} (over the support of its
+            # collection, refitted since); not Double FQI's values
+            future = None if self.double or supported is not None else data.next_values
             if future is None:
-                future = self._q.future(data, self.n_jobs, split)
+                future = self._q.future(data, self.n_jobs, split, supported)
             discounts = np.where(data.terminated, 0.0, self.gamma)
             targets += discounts * future
             if self.leaf_backups:
-                targets = self._q.backups(data, targets, discounts, self.leaf_backups, split)
+                targets = self._q.backups(data, targets, discounts, self.leaf_backups, split,
+                                          supported)
         data.next_values = None  # stale once Q_n is fitted
         return targets
 
@@ -822,6 +900,24 @@ class FQI:
             raise NotFittedError("this FQI agent has no Q-function yet; call learn() first")
         return self._q.values(batch, self.n_jobs)
 
+    def _supported(self, batch):
+        """The actions supported at the observations of `batch` (`support_threshold`), a
+        mask of shape ``(n, n_actions)``; None when every action is."""
+        if self._support is None or not self.support_threshold:
+            return None
+        return self._support.supported(batch, self.support_threshold)
+
+    def _acting_values(self, batch):
+        """The Q-values the greedy policy picks from: those of unsupported actions at
+        -inf."""
+        return _masked(self._q_values(batch), self._supported(batch))
+
+    @property
+    def support_model_(self) -> Any:
+        """The behaviour model fitted on the offline data (see `support_threshold`), None
+        without one."""
+        return None if self._support is None else self._support.model
+
     @property
     def q_functions_(self) -> list[Regressor] | None:
         """The fitted ``Q_n``, one regressor per action (None before the first iteration);
@@ -847,7 +943,9 @@ class FQI:
         state, episode_start
             Unused (the policy is reactive); accepted for stable-baselines3.
         deterministic : bool, default=True
-            Greedy actions; False draws epsilon-greedy ones (with `exploration_rate`).
+            Greedy actions (among the actions the data support, after `learn_offline`:
+            `support_threshold`); False draws epsilon-greedy ones (with
+            `exploration_rate`).
 
         Returns
         -------
@@ -855,7 +953,7 @@ class FQI:
         state : None
         """
         batch, single = self._observations.as_input(observation)
-        q = self._q_values(batch)
+        q = self._acting_values(batch)
         actions = q.argmax(axis=1) if deterministic else self._epsilon_greedy(q)
         return (actions[0] if single else actions), None
 
@@ -920,7 +1018,7 @@ class FQI:
                                  f"{path} holds one made with {name}={state[name]}")
         agent._check_action_input(agent._observations, agent.observation_space)
         agent._env = agent._eval_env = agent._collector = agent._held = None
-        agent._data = agent._logger = None
+        agent._data = agent._next_supported = agent._logger = None
         env = agent.env if env is None else env
         if env is not None:
             agent.set_env(env)
@@ -935,7 +1033,7 @@ class FQI:
         state = self.__dict__.copy()
         state["_logger"] = None  # SB3's loggers hold open files
         if self._collects() and not self.keep_data:
-            state["_data"] = None
+            state["_data"] = state["_next_supported"] = None
         return state
 
     def __repr__(self) -> str:

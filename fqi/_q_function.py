@@ -58,12 +58,13 @@ class _QFunction:
                      "fqi-actions")
         return cls(models, iteration)
 
-    def future(self, data, n_jobs=1, split=None):
-        """``max_a Q(s', a)`` for the next state of every transition of `data` (`split` is
-        `_DoubleQFunction`'s; unused here)."""
-        return self.values(data.next_states, n_jobs).max(axis=1)
+    def future(self, data, n_jobs=1, split=None, supported=None):
+        """``max_a Q(s', a)`` for the next state of every transition of `data`, over the
+        actions `supported` there (a mask of shape ``(len(data), n_actions)``; None: every
+        action). `split` is `_DoubleQFunction`'s; unused here."""
+        return _masked(self.values(data.next_states, n_jobs), supported).max(axis=1)
 
-    def backups(self, data, targets, discounts, n_backups, split=None):
+    def backups(self, data, targets, discounts, n_backups, split=None, supported=None):
         """`targets` after `n_backups` fitted-Q backups that keep these models' trees.
 
         Each backup sets every leaf's value to the mean target of the transitions of the
@@ -84,6 +85,8 @@ class _QFunction:
         n_backups : int
         split : None
             `_DoubleQFunction`'s; unused here.
+        supported : ndarray of bool of shape (len(data), n_actions), default=None
+            The actions the maximum is taken over at each next state (None: every one).
 
         Returns
         -------
@@ -93,7 +96,7 @@ class _QFunction:
         tables = self._leaf_tables(data, rows)
         for _ in range(n_backups):
             q = _leaf_values(tables, targets, data.actions, rows)
-            targets = data.rewards + discounts * q.max(axis=1)
+            targets = data.rewards + discounts * _masked(q, supported).max(axis=1)
         return targets
 
     def _leaf_tables(self, data, rows):
@@ -186,7 +189,7 @@ class _ActionInputQFunction:
 
     future = _QFunction.future  # max_a Q(s', a) through `values`, as for one per action
 
-    def backups(self, data, targets, discounts, n_backups, split=None):
+    def backups(self, data, targets, discounts, n_backups, split=None, supported=None):
         """`_QFunction.backups` on the one regressor: its leaves hold the mean targets of
         every transition that reaches them, whatever its action."""
         table = _LeafTable(self.model,
@@ -194,7 +197,7 @@ class _ActionInputQFunction:
                            self._every_action(data.next_states))
         for _ in range(n_backups):
             q = table.next_values(targets).reshape(len(data), self.n_actions)
-            targets = data.rewards + discounts * q.max(axis=1)
+            targets = data.rewards + discounts * _masked(q, supported).max(axis=1)
         return targets
 
 
@@ -291,22 +294,30 @@ class _DoubleQFunction:
         first, second = (half.values(batch, n_jobs) for half in self.halves)
         return (first + second) / 2
 
-    def future(self, data, n_jobs=1, split=None):
+    def future(self, data, n_jobs=1, split=None, supported=None):
         """Each transition's bootstrap value: the action chosen by the Q-function of its
-        half (`split`: the transitions of the first), valued by the other's."""
-        first, second = (half.values(data.next_states, n_jobs) for half in self.halves)
+        half (`split`: the transitions of the first) among those `supported`, valued by
+        the other's."""
+        first, second = (_masked(half.values(data.next_states, n_jobs), supported)
+                         for half in self.halves)
         return _crossed(first, second, split)
 
-    def backups(self, data, targets, discounts, n_backups, split=None):
+    def backups(self, data, targets, discounts, n_backups, split=None, supported=None):
         """`_QFunction.backups`, each half's leaves holding the mean targets of its own
         transitions, and the bootstrap values crossed as in `future`."""
         halves = [(half, rows, half._leaf_tables(data, rows))
                   for half, rows in zip(self.halves, (split, ~split))]
         for _ in range(n_backups):
-            first, second = (_leaf_values(tables, targets, data.actions, rows)
-                             for _, rows, tables in halves)
+            first, second = (_masked(_leaf_values(tables, targets, data.actions, rows),
+                                     supported) for _, rows, tables in halves)
             targets = data.rewards + discounts * _crossed(first, second, split)
         return targets
+
+
+def _masked(q, supported):
+    """The Q-values `q` with those of the actions not `supported` (a mask of their shape)
+    at -inf; `q` itself when `supported` is None."""
+    return q if supported is None else np.where(supported, q, -np.inf)
 
 
 def _crossed(first, second, split):

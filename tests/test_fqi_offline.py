@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from sklearn.ensemble import ExtraTreesRegressor
 
-from boxtrees import BoxExtraTreesRegressor, ObjectSets
+from boxtrees import BoxExtraTreesClassifier, BoxExtraTreesRegressor, ObjectSets
 from fqi import FQI, RandomPolicy, evaluate
 
 
@@ -67,6 +67,10 @@ def test_object_sets_are_learned_from_a_mapping():
                 gamma=0.5, eval_episodes=0, seed=0).learn_offline(data, n_iterations=3)
     learned = evaluate(agent, NearestType, seeds=range(50)).mean
     assert learned > 8, learned  # of 10 steps; random play scores about 3.4
+    # the offline constraint's behaviour model takes the object sets too
+    assert isinstance(agent.support_model_, BoxExtraTreesClassifier)
+    supported = agent._next_supported
+    assert supported.shape == (3000, 3) and supported.all(axis=1).mean() > 0.8
 
 
 @pytest.mark.filterwarnings("ignore:.*is set to None:UserWarning")  # its metadata
