@@ -6,8 +6,8 @@ import joblib
 
 __all__ = []
 
-_SAVE_FORMAT = 7  # 3: exploration schedule, not epsilon; 4: tie_break; 5: leaf_backups;
-#                   6: double; 7: action_input
+_SAVE_FORMAT = 8  # 3: exploration schedule, not epsilon; 4: tie_break; 5: leaf_backups;
+#                   6: double; 7: action_input; 8: support_threshold, support_classifier
 
 
 def _write_save(state, path):
