@@ -574,31 +574,50 @@ cdef void _walk_padded(const ForestView* forest, const coord_t* objects, intp_t 
     """`_walk` with the portable node test on padded objects (`boxtrees_count_padded`: sample
     ``i``'s start at ``objects + layout[2 * i]``, ``m = layout[2 * i + 1]``), in blocks, tree
     by tree, as `_walk`: the same leaves, and the same means."""
-    cdef const boxtrees_node* nodes = forest.nodes
-    cdef const intp_t* tree_offsets = forest.tree_offsets
-    cdef const float64_t* value = forest.value
-    cdef intp_t n_trees = forest.n_trees, n_outputs = forest.n_outputs
-    cdef intp_t block = 0, block_end, tree, i, k, leaf
+    cdef intp_t block = 0, block_end, tree, i
     while block < n_samples:
         block_end = min(block + <intp_t>BLOCK, n_samples)
-        if mean != NULL:
-            for i in range(block * n_outputs, block_end * n_outputs):
-                mean[i] = 0.0
-        for tree in range(n_trees):
+        _zero_means(forest, mean, block, block_end)
+        for tree in range(forest.n_trees):
             for i in range(block, block_end):
-                leaf = boxtrees_walk_padded(nodes + tree_offsets[tree], forest.extras,
-                                            objects + layout[2 * i], n_attributes,
-                                            layout[2 * i + 1])
-                if mean == NULL:
-                    leaves[i * n_trees + tree] = leaf
-                    continue
-                leaf = (tree_offsets[tree] + leaf) * n_outputs
-                for k in range(n_outputs):
-                    mean[i * n_outputs + k] += value[leaf + k]
-        if mean != NULL:
-            for i in range(block * n_outputs, block_end * n_outputs):
-                mean[i] /= n_trees
+                _record(forest, tree, i, boxtrees_walk_padded(
+                    forest.nodes + forest.tree_offsets[tree], forest.extras,
+                    objects + layout[2 * i], n_attributes, layout[2 * i + 1]), mean, leaves)
+        _average_means(forest, mean, block, block_end)
         block = block_end
+
+
+cdef inline void _zero_means(const ForestView* forest, float64_t* mean, intp_t start,
+                             intp_t end) noexcept nogil:
+    """Set the means of samples ``start`` to ``end`` to 0 (nothing when `mean` is NULL)."""
+    cdef intp_t i
+    if mean != NULL:
+        for i in range(start * forest.n_outputs, end * forest.n_outputs):
+            mean[i] = 0.0
+
+
+cdef inline void _average_means(const ForestView* forest, float64_t* mean, intp_t start,
+                                intp_t end) noexcept nogil:
+    """Divide the sums of samples ``start`` to ``end`` by the number of trees (nothing when
+    `mean` is NULL)."""
+    cdef intp_t i
+    if mean != NULL:
+        for i in range(start * forest.n_outputs, end * forest.n_outputs):
+            mean[i] /= forest.n_trees
+
+
+cdef inline void _record(const ForestView* forest, intp_t tree, intp_t i, intp_t leaf,
+                         float64_t* mean, intp_t* leaves) noexcept nogil:
+    """Sample ``i`` reached tree-local `leaf` of `tree`: its values added to sample ``i``'s
+    sums in `mean`, or, when `mean` is NULL, the leaf written into the (n_samples, n_trees)
+    `leaves`."""
+    cdef intp_t k, n_outputs = forest.n_outputs
+    if mean == NULL:
+        leaves[i * forest.n_trees + tree] = leaf
+        return
+    leaf = (forest.tree_offsets[tree] + leaf) * n_outputs
+    for k in range(n_outputs):
+        mean[i * n_outputs + k] += forest.value[leaf + k]
 
 
 cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_objects,
@@ -612,32 +631,19 @@ cdef void _walk(const ForestView* forest, const coord_t* features, intp_t n_obje
     sample into ``mean`` or, when ``mean`` is NULL, the tree-local leaf ids into the
     (n_samples, n_trees) ``leaves``; ``mean`` holds ``n_outputs`` values per sample.
     """
-    cdef const boxtrees_node* nodes = forest.nodes
-    cdef const intp_t* tree_offsets = forest.tree_offsets
-    cdef const float64_t* value = forest.value
-    cdef intp_t n_trees = forest.n_trees, n_outputs = forest.n_outputs
-    cdef intp_t block = 0, block_end, tree, i, k, leaf
+    cdef intp_t block = 0, block_end, tree, i
     cdef intp_t block_leaves[BLOCK]
     while block < n_samples:
         block_end = min(block + <intp_t>BLOCK, n_samples)
-        if mean != NULL:
-            for i in range(block * n_outputs, block_end * n_outputs):
-                mean[i] = 0.0
-        for tree in range(n_trees):
-            _kernels.find_leaves(nodes + tree_offsets[tree], forest.extras, forest.chains,
-                                 features, n_objects, positions, type_ptr + block * stride,
-                                 stride, block_end - block, block_leaves)
+        _zero_means(forest, mean, block, block_end)
+        for tree in range(forest.n_trees):
+            _kernels.find_leaves(forest.nodes + forest.tree_offsets[tree], forest.extras,
+                                 forest.chains, features, n_objects, positions,
+                                 type_ptr + block * stride, stride, block_end - block,
+                                 block_leaves)
             for i in range(block, block_end):
-                leaf = block_leaves[i - block]
-                if mean == NULL:
-                    leaves[i * n_trees + tree] = leaf
-                    continue
-                leaf = (tree_offsets[tree] + leaf) * n_outputs
-                for k in range(n_outputs):
-                    mean[i * n_outputs + k] += value[leaf + k]
-        if mean != NULL:
-            for i in range(block * n_outputs, block_end * n_outputs):
-                mean[i] /= n_trees
+                _record(forest, tree, i, block_leaves[i - block], mean, leaves)
+        _average_means(forest, mean, block, block_end)
         block = block_end
 
 
