@@ -7,13 +7,13 @@ import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor, wait
 from functools import lru_cache, partial
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from joblib import effective_n_jobs
 from joblib.parallel import get_active_backend
 from sklearn import config_context, get_config
 
-__all__ = ["side_by_side", "thread_pool", "threads_for"]
+__all__ = ["configured", "side_by_side", "thread_pool", "threads_for"]
 
 T = TypeVar("T")
 
@@ -112,7 +112,7 @@ def side_by_side(tasks: Sequence[Callable[[], T]], purpose: str,
     config = get_config()
     try:
         for task in tasks[1:]:      # one by one: a failed submit still waits for the others
-            others.append(pool.submit(partial(_configured, config, task)))
+            others.append(pool.submit(partial(configured, config, task)))
         _LOCAL.siblings = n_threads
         first = tasks[0]()
     finally:
@@ -124,10 +124,12 @@ def side_by_side(tasks: Sequence[Callable[[], T]], purpose: str,
     return [first] + [future.result() for future in others]
 
 
-def _configured(config, task):
-    """``task()`` under the scikit-learn configuration `config`."""
+def configured(config: dict[str, Any], function: Callable[..., T], *args: Any,
+               **kwargs: Any) -> T:
+    """``function(*args, **kwargs)`` under the scikit-learn configuration `config` (a
+    ``sklearn.get_config()`` of another thread: the configuration belongs to a thread)."""
     with config_context(**config):
-        return task()
+        return function(*args, **kwargs)
 
 
 def threads_for(n_jobs: int | None) -> int:

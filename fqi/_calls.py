@@ -27,7 +27,8 @@ from multiprocessing.pool import ThreadPool
 from joblib import parallel_config, register_parallel_backend
 from joblib._parallel_backends import LokyBackend, ThreadingBackend
 from joblib.parallel import get_active_backend
-from sklearn import config_context
+
+from boxtrees._threads import configured
 
 __all__ = []
 
@@ -85,12 +86,7 @@ def _unswapped(task):
     function, config = getattr(task, "function", None), getattr(task, "config", None)
     if function is None or not isinstance(config, dict) or not config:
         return task
-    return partial(_configured, function, config)
-
-
-def _configured(function, config, *args, **kwargs):
-    with config_context(**config):
-        return function(*args, **kwargs)
+    return partial(configured, config, function)
 
 
 def _regressor_calls(n_predicted=None):
