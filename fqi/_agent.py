@@ -211,10 +211,10 @@ class FQI:
         in a vector env of one env per episode): ``len(eval_seeds)`` when those are given,
         else 10 when `eval_env` is given, else none: as stable-baselines3's ``learn``,
         FQI evaluates nothing unless asked (there, with an ``EvalCallback``), and
-        ``history``'s ``train_return`` follows the training episodes meanwhile. Each evaluation plays whole episodes with a prediction per step: on
-        CartPole-v1, 10 episodes after every iteration took 80% of `learn`'s time with a
-        30-tree forest. 0 evaluates nothing (``reward`` is then NaN), whatever
-        `eval_seeds`.
+        ``history``'s ``train_return`` follows the training episodes meanwhile. Each
+        evaluation plays whole episodes with a prediction per step: on CartPole-v1, 10
+        episodes after every iteration took 80% of `learn`'s time with a 30-tree forest.
+        0 evaluates nothing (``reward`` is then NaN), whatever `eval_seeds`.
     eval_seeds : sequence of int, default=None
         Reset seed of each evaluation episode, fixed for the whole run. Default
         ``2**40, 2**40 + 1, ...``: training draws its reset seeds below ``2**40``, so those

@@ -128,8 +128,9 @@ def evaluate(policy: Policy, env: EnvLike, n_episodes: int | None = None,
     The episodes run side by side on a vector env (one env per episode; a given
     `gymnasium.vector.VectorEnv` plays them in rounds of its size), each reset with its
     own seed and played until it terminates, is truncated, or reaches `max_episode_steps`.
-    Nothing else is random, so the same policy scores the same. The thesis's evaluation is ``seeds=envs.reference_worlds(
-    400)`` on ObjectWorld: 400 episodes of 50 steps, 20,000 steps, scored by ``total``.
+    Nothing else is random, so the same policy scores the same. The thesis's evaluation is
+    ``seeds=envs.reference_worlds(400)`` on ObjectWorld: 400 episodes of 50 steps, 20,000
+    steps, scored by ``total``.
 
     Parameters
     ----------
